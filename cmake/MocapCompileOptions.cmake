@@ -1,0 +1,48 @@
+# Project-wide compile options: warnings are errors; optional sanitizers.
+# mocap_add_library(name SOURCES ... DEPS ...) and mocap_target_options(target)
+# apply them uniformly, so every module builds the same way.
+
+set(MOCAP_WARNINGS -Wall -Wextra -Wpedantic -Wshadow -Wconversion -Wno-sign-conversion
+    -Wnon-virtual-dtor -Wold-style-cast -Wcast-align -Woverloaded-virtual
+    -Wdouble-promotion -Wformat=2 -Wimplicit-fallthrough -Werror)
+
+if(MOCAP_SANITIZE)
+  string(REPLACE ";" "," _mocap_san "${MOCAP_SANITIZE}")
+  add_compile_options(-fsanitize=${_mocap_san} -fno-omit-frame-pointer -fno-sanitize-recover=all)
+  add_link_options(-fsanitize=${_mocap_san})
+  message(STATUS "mocap: sanitizers ${_mocap_san}")
+endif()
+
+function(mocap_target_options target)
+  target_compile_options(${target} PRIVATE ${MOCAP_WARNINGS})
+  target_include_directories(${target} PUBLIC ${PROJECT_SOURCE_DIR}/src ${PROJECT_SOURCE_DIR})
+endfunction()
+
+# mocap_add_library(<name> SOURCES <files...> DEPS <targets...>)
+function(mocap_add_library name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS" ${ARGN})
+  add_library(${name} STATIC ${ARG_SOURCES})
+  mocap_target_options(${name})
+  target_link_libraries(${name} PUBLIC ${ARG_DEPS})
+endfunction()
+
+# mocap_add_test(<name> SOURCES <files...> DEPS <targets...> [LABELS <labels...>])
+# Registers every TEST() of the executable with ctest. Label "concurrency" marks the
+# tests that the ThreadSanitizer configuration runs.
+function(mocap_add_test name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS;LABELS" ${ARGN})
+  add_executable(${name} ${ARG_SOURCES})
+  mocap_target_options(${name})
+  target_link_libraries(${name} PRIVATE ${ARG_DEPS} GTest::gtest_main GTest::gmock)
+  gtest_discover_tests(${name} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}
+    PROPERTIES LABELS "${ARG_LABELS}" ENVIRONMENT "MOCAP_SOURCE_DIR=${PROJECT_SOURCE_DIR};MOCAP_BINARY_DIR=${PROJECT_BINARY_DIR}"
+    DISCOVERY_TIMEOUT 60)
+endfunction()
+
+# mocap_add_bench(<name> SOURCES <files...> DEPS <targets...>)
+function(mocap_add_bench name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS" ${ARGN})
+  add_executable(${name} ${ARG_SOURCES})
+  mocap_target_options(${name})
+  target_link_libraries(${name} PRIVATE ${ARG_DEPS} benchmark::benchmark)
+endfunction()

@@ -1,0 +1,45 @@
+#!/usr/bin/env bash
+# Installs every build, test and run dependency of the mocap tracker from Debian 12's
+# packages. Idempotent: packages already present are skipped, so a second run is quick.
+# Usage (as root, or with sudo available):  bash deploy/install-deps.sh [--with-bench-baseline]
+set -euo pipefail
+
+packages=(
+  # toolchain
+  build-essential cmake ninja-build pkg-config git clang libclang-rt-14-dev clang-format
+  # core libraries
+  libeigen3-dev libceres-dev libyaml-cpp-dev libcli11-dev
+  # tests and benchmarks
+  libgtest-dev libgmock-dev libbenchmark-dev
+  # shared-memory transport (iceoryx 2.0) and its ACL dependency
+  iceoryx libiceoryx-posh-dev libiceoryx-hoofs-dev libacl1-dev
+  # cameras: libcamera and the V4L2 headers
+  libcamera-dev linux-libc-dev libv4l-dev
+  # service integration and tools used by tests
+  libsystemd-dev systemd liburdfdom-tools python3
+  # the OpenCV comparison baseline of bench/ (never linked by the product)
+  libopencv-dev
+)
+
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then
+  if command -v sudo >/dev/null 2>&1; then SUDO="sudo"; else
+    echo "install-deps.sh: must run as root (or with sudo available)" >&2; exit 1; fi
+fi
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps.sh: all ${#packages[@]} packages already installed"
+  exit 0
+fi
+
+echo "install-deps.sh: installing ${#missing[@]} packages: ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"

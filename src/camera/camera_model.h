@@ -1,0 +1,61 @@
+// Design: the pinhole camera with OpenCV's 5-parameter distortion [k1 k2 p1 p2 k3],
+// applied to normalised coordinates exactly as cv::projectPoints does:
+//   x' = X_cam.x / X_cam.z, y' = X_cam.y / X_cam.z, r2 = x'^2 + y'^2
+//   radial = 1 + k1 r2 + k2 r2^2 + k3 r2^3
+//   x'' = x' radial + 2 p1 x' y' + p2 (r2 + 2 x'^2)
+//   y'' = y' radial + p1 (r2 + 2 y'^2) + 2 p2 x' y'
+//   u = fx x'' + cx,  v = fy y'' + cy      (pixel centre of the top-left pixel = (0,0))
+// Extrinsics map world to camera: X_cam = R_cam_world * X_world + t_cam_world (mm).
+// All functions are noexcept and allocation-free: they run on the hot path.
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "core/types.h"
+
+namespace mocap {
+
+struct CameraModel {
+  std::string name;
+  int width = 0;
+  int height = 0;
+  double fx = 0.0, fy = 0.0, cx = 0.0, cy = 0.0;
+  std::array<double, 5> distortion{};  // k1, k2, p1, p2, k3
+  Mat3 R_cam_world = Mat3::Identity();
+  Vec3 t_cam_world = Vec3::Zero();
+
+  Iso3 T_cam_world() const { return make_iso(R_cam_world, t_cam_world); }
+  // Optical centre in world coordinates.
+  Vec3 center_world() const { return -R_cam_world.transpose() * t_cam_world; }
+};
+
+struct Rig {
+  std::vector<CameraModel> cameras;  // the first two form the stereo pair
+};
+
+// Normalised undistorted (x', y') -> normalised distorted (x'', y'').
+Vec2 distort_normalized(const CameraModel& cam, const Vec2& xn) noexcept;
+// Jacobian d(x'', y'') / d(x', y').
+Eigen::Matrix2d distort_jacobian(const CameraModel& cam, const Vec2& xn) noexcept;
+
+// Normalised undistorted -> pixel, and pixel -> normalised distorted.
+Vec2 normalized_to_pixel(const CameraModel& cam, const Vec2& xn) noexcept;
+
+// World point -> pixel. Returns false (px untouched) when the point is not in front
+// of the camera (z <= 1e-9 mm).
+bool project(const CameraModel& cam, const Vec3& X_world, Vec2& px) noexcept;
+// Same, with the 2x3 Jacobian d(px)/d(X_world).
+bool project(const CameraModel& cam, const Vec3& X_world, Vec2& px,
+             Eigen::Matrix<double, 2, 3>& J_px_X) noexcept;
+
+// Pixel -> normalised undistorted coordinates (x', y'): inverts the distortion by
+// Gauss-Newton started from the fixed-point estimate; converges to < 1e-12 over the
+// whole image for realistic lenses. Returns false when it did not converge.
+bool undistort_pixel(const CameraModel& cam, const Vec2& px, Vec2& xn) noexcept;
+
+// Unit ray direction in world coordinates through a pixel (false: no convergence).
+bool pixel_ray_world(const CameraModel& cam, const Vec2& px, Vec3& dir_world) noexcept;
+
+}  // namespace mocap

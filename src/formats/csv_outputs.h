@@ -1,0 +1,75 @@
+// Design: the spec's output CSV files (points.csv, poses.csv, angles.csv): row types,
+// streaming writers (header first, one row per item, fixed precision, '\n' line ends)
+// and readers used by evaluation scripts and tests. Angles are written in degrees;
+// quaternions with qw >= 0.
+#pragma once
+
+#include <cstdint>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/expected.h"
+#include "core/types.h"
+#include "formats/joints_yaml.h"
+
+namespace mocap {
+
+struct PointRow {
+  std::int64_t frame = 0;
+  Vec3 X_world = Vec3::Zero();
+  double reproj_px = 0.0;
+};
+
+struct PoseRow {
+  std::int64_t frame = 0;
+  std::int64_t timestamp_ns = 0;
+  std::string body;
+  Quat q_world_body = Quat::Identity();
+  Vec3 t_world_body = Vec3::Zero();
+  int markers = 0;
+  double rms_mm = 0.0;
+};
+
+struct AngleRow {
+  std::int64_t frame = 0;
+  std::int64_t timestamp_ns = 0;
+  std::string joint;
+  JointType type = JointType::kBall;
+  Vec3 angles_deg = Vec3::Zero();  // hinge: (angle, 0, 0)
+  Quat q_parent_child = Quat::Identity();
+};
+
+// A CSV file opened for writing; the header is written at open.
+class CsvFile {
+ public:
+  static Expected<CsvFile> open(const std::string& path, const char* header);
+  CsvFile(CsvFile&&) noexcept = default;
+  CsvFile& operator=(CsvFile&&) noexcept = default;
+  ~CsvFile() = default;
+  std::FILE* handle() const noexcept { return file_.get(); }
+  const std::string& path() const noexcept { return path_; }
+  // Flushes and closes; an Error when the data could not be written (disk full...).
+  Expected<void> close();
+
+ private:
+  struct Closer {
+    void operator()(std::FILE* f) const noexcept { if (f) std::fclose(f); }
+  };
+  std::unique_ptr<std::FILE, Closer> file_;
+  std::string path_;
+};
+
+Expected<CsvFile> open_points_csv(const std::string& path);
+Expected<CsvFile> open_poses_csv(const std::string& path);
+Expected<CsvFile> open_angles_csv(const std::string& path);
+void write_row(CsvFile& f, const PointRow& r) noexcept;
+void write_row(CsvFile& f, const PoseRow& r) noexcept;
+void write_row(CsvFile& f, const AngleRow& r) noexcept;
+
+Expected<std::vector<PointRow>> read_points_csv(const std::string& path);
+Expected<std::vector<PoseRow>> read_poses_csv(const std::string& path);
+Expected<std::vector<AngleRow>> read_angles_csv(const std::string& path);
+
+}  // namespace mocap

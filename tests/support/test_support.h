@@ -1,0 +1,75 @@
+// Design: small helpers shared by the tests: temporary folders, file writing, the path
+// of the built `mocap` binary, and running it to capture its exit code and stderr.
+#pragma once
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <sys/wait.h>
+
+namespace mocap::test {
+
+// A fresh, empty temporary folder (removed at destruction).
+class TempDir {
+ public:
+  explicit TempDir(const std::string& tag) {
+    std::string templ = (std::filesystem::temp_directory_path() / ("mocap_" + tag + "_XXXXXX")).string();
+    char* p = mkdtemp(templ.data());
+    path_ = p ? std::string(p) : std::string();
+  }
+  ~TempDir() {
+    std::error_code ec;
+    if (!path_.empty()) std::filesystem::remove_all(path_, ec);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  const std::string& path() const { return path_; }
+  std::string file(const std::string& name) const { return path_ + "/" + name; }
+
+ private:
+  std::string path_;
+};
+
+inline void write_file(const std::string& path, const std::string& content) {
+  std::filesystem::create_directories(std::filesystem::path(path).parent_path());
+  std::ofstream f(path, std::ios::binary);
+  f << content;
+}
+
+inline std::string read_file(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
+}
+
+inline std::string source_dir() {
+  const char* s = std::getenv("MOCAP_SOURCE_DIR");
+  return s ? s : ".";
+}
+
+inline std::string mocap_binary() {
+  const char* b = std::getenv("MOCAP_BINARY_DIR");
+  return std::string(b ? b : ".") + "/mocap";
+}
+
+struct RunResult {
+  int exit_code = -1;
+  std::string output;  // stdout and stderr together
+};
+
+// Runs `mocap <args>` through the shell, capturing stdout+stderr.
+inline RunResult run_mocap(const std::string& args) {
+  RunResult r;
+  const std::string cmd = mocap_binary() + " " + args + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  if (!p) return r;
+  char buf[4096];
+  size_t n;
+  while ((n = fread(buf, 1, sizeof buf, p)) > 0) r.output.append(buf, n);
+  const int status = pclose(p);
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+}  // namespace mocap::test
