@@ -26,6 +26,11 @@ function(mocap_add_library name)
   target_link_libraries(${name} PUBLIC ${ARG_DEPS})
 endfunction()
 
+# Aggregate targets: every test binary, and the ones labelled "concurrency" (the
+# ThreadSanitizer job builds only those).
+add_custom_target(mocap_all_tests)
+add_custom_target(mocap_concurrency_tests)
+
 # mocap_add_test(<name> SOURCES <files...> DEPS <targets...> [LABELS <labels...>])
 # Registers every TEST() of the executable with ctest. Label "concurrency" marks the
 # tests that the ThreadSanitizer configuration runs.
@@ -34,6 +39,10 @@ function(mocap_add_test name)
   add_executable(${name} ${ARG_SOURCES})
   mocap_target_options(${name})
   target_link_libraries(${name} PRIVATE ${ARG_DEPS} GTest::gtest_main GTest::gmock)
+  if("concurrency" IN_LIST ARG_LABELS)
+    add_dependencies(mocap_concurrency_tests ${name})
+  endif()
+  add_dependencies(mocap_all_tests ${name})
   gtest_discover_tests(${name} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}
     PROPERTIES LABELS "${ARG_LABELS}" ENVIRONMENT "MOCAP_SOURCE_DIR=${PROJECT_SOURCE_DIR};MOCAP_BINARY_DIR=${PROJECT_BINARY_DIR}"
     DISCOVERY_TIMEOUT 60)
