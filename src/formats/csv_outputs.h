@@ -54,8 +54,11 @@ class CsvFile {
   Expected<void> close();
 
  private:
+  CsvFile() = default;
   struct Closer {
-    void operator()(std::FILE* f) const noexcept { if (f) std::fclose(f); }
+    void operator()(std::FILE* f) const noexcept {
+      if (f) std::fclose(f);
+    }
   };
   std::unique_ptr<std::FILE, Closer> file_;
   std::string path_;

@@ -13,11 +13,14 @@
 
 namespace mocap {
 
+// Largest accepted image width or height (PGM files and rig.yaml), in pixels.
+inline constexpr int kMaxImageSidePx = 16384;
+
 Expected<void> read_pgm(const std::string& path, Image& out);
 // As read_pgm, but fails with "<path>: size WxH differs from the rig's WxH" when the
 // image size is not the expected one.
-Expected<void> read_pgm_expect(const std::string& path, int expected_width,
-                               int expected_height, Image& out);
+Expected<void> read_pgm_expect(const std::string& path, int expected_width, int expected_height,
+                               Image& out);
 Expected<void> write_pgm(const std::string& path, const ImageView& image);
 
 }  // namespace mocap

@@ -37,8 +37,10 @@ class Recording {
   const std::vector<FrameEntry>& frames() const noexcept { return frames_; }
 
   // Reads camera `camera_index`'s image of `frame` into `out` (reusing its buffer).
-  // kMissing when the file does not exist; an Error when it exists but is malformed
-  // or its size differs from the rig's.
+  // kMissing when the file does not exist (out is left untouched); an Error naming the
+  // file when it exists but is malformed or its size differs from the rig's. Allocates
+  // nothing when `out` already has the rig's size and the frame's pixel format; safe to
+  // call from several threads at once (each with its own Image).
   Expected<FrameLoad> load_frame(int camera_index, std::int64_t frame, Image& out) const;
 
  private:

@@ -2,6 +2,7 @@
 // counts allocations per thread (thread_local counter: no locks, no atomics needed).
 #include "tests/support/alloc_counter.h"
 
+#include <cstddef>
 #include <cstdlib>
 #include <new>
 

@@ -1,0 +1,110 @@
+// Design: the recording folder (see recording.h, docs/formats.md). open() validates
+// rig.yaml, frames.csv and the presence of every camera's folder, so that replay only
+// meets per-frame problems. load_frame builds the frame's path in a stack buffer and
+// reads with the allocation-free PGM core: replaying into the same Image allocates
+// nothing per frame.
+#include "formats/recording.h"
+
+#include <sys/stat.h>
+
+#include <cstdio>
+
+#include "formats/csv_parse.h"
+#include "formats/pgm_read.h"
+#include "formats/rig_yaml.h"
+#include "formats/text_io.h"
+
+namespace mocap {
+
+using namespace formats_detail;
+
+Expected<std::vector<FrameEntry>> load_frames_csv(const std::string& path) {
+  auto reader = CsvReader::open(path, "frame,timestamp_ns");
+  if (!reader) return reader.error();
+  return guard_fields<std::vector<FrameEntry>>(path, [&]() -> Expected<std::vector<FrameEntry>> {
+    CsvReader& r = *reader;
+    std::vector<FrameEntry> frames;
+    while (r.next()) {
+      FrameEntry e;
+      e.frame = r.integer(0);
+      e.timestamp_ns = r.integer(1);
+      if (frames.empty() && e.frame != 0) {
+        fail(r.where(), "the first frame is " + std::to_string(e.frame) + ", frames start at 0");
+      }
+      if (!frames.empty() && e.frame <= frames.back().frame) {
+        fail(r.where(), "frame " + std::to_string(e.frame) + " does not follow frame " +
+                            std::to_string(frames.back().frame) + " (must be strictly increasing)");
+      }
+      if (e.timestamp_ns < 0) {
+        fail(r.where(), "negative timestamp_ns " + std::to_string(e.timestamp_ns));
+      }
+      frames.push_back(e);
+    }
+    if (frames.empty()) fail("", "no frames (only the header)");
+    return frames;
+  });
+}
+
+Expected<void> save_frames_csv(const std::string& path, const std::vector<FrameEntry>& frames) {
+  std::string out = "frame,timestamp_ns\n";
+  out.reserve(out.size() + frames.size() * 32);
+  for (const FrameEntry& e : frames) {
+    out += std::to_string(e.frame);
+    out += ',';
+    out += std::to_string(e.timestamp_ns);
+    out += '\n';
+  }
+  return write_text_file(path, out);
+}
+
+std::string frame_file_path(const std::string& dir, const std::string& camera, std::int64_t frame) {
+  char name[32];
+  std::snprintf(name, sizeof name, "%06lld.pgm", static_cast<long long>(frame));
+  return dir + "/" + camera + "/" + name;
+}
+
+Expected<Recording> Recording::open(const std::string& dir) {
+  struct stat st {};
+  if (::stat(dir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode)) {
+    return make_error(dir, "", "not a recording folder (no such directory)");
+  }
+  Recording rec;
+  rec.dir_ = dir;
+  auto rig = load_rig(dir + "/rig.yaml");
+  if (!rig) return rig.error();
+  rec.rig_ = std::move(*rig);
+  auto frames = load_frames_csv(dir + "/frames.csv");
+  if (!frames) return frames.error();
+  rec.frames_ = std::move(*frames);
+  for (const CameraModel& cam : rec.rig_.cameras) {
+    const std::string folder = dir + "/" + cam.name;
+    if (::stat(folder.c_str(), &st) != 0 || !S_ISDIR(st.st_mode)) {
+      return make_error(folder, "",
+                        "missing folder of camera '" + cam.name + "' named in rig.yaml");
+    }
+  }
+  return rec;
+}
+
+Expected<FrameLoad> Recording::load_frame(int camera_index, std::int64_t frame, Image& out) const {
+  if (camera_index < 0 || static_cast<std::size_t>(camera_index) >= rig_.cameras.size()) {
+    return make_error(dir_, "",
+                      "camera index " + std::to_string(camera_index) + " out of range (" +
+                          std::to_string(rig_.cameras.size()) + " cameras)");
+  }
+  if (frame < 0 || frame > 999999999) {
+    return make_error(dir_, "", "frame number " + std::to_string(frame) + " out of range");
+  }
+  const CameraModel& cam = rig_.cameras[static_cast<std::size_t>(camera_index)];
+  char path[4096];
+  const int len = std::snprintf(path, sizeof path, "%s/%s/%06lld.pgm", dir_.c_str(),
+                                cam.name.c_str(), static_cast<long long>(frame));
+  if (len < 0 || static_cast<std::size_t>(len) >= sizeof path) {
+    return make_error(dir_, "", "frame path too long");
+  }
+  bool missing = false;
+  if (auto r = read_pgm_path(path, cam.width, cam.height, out, &missing); !r) return r.error();
+  return missing ? FrameLoad::kMissing : FrameLoad::kOk;
+}
+
+}  // namespace mocap
