@@ -1,0 +1,58 @@
+#include "track/calibration_input.h"
+
+#include "formats/recording.h"
+
+namespace mocap {
+
+Expected<CollectedCalibration> collect_calibration_input(const std::string& recording_dir,
+                                                         const TargetSet& targets,
+                                                         const CalibrationCollectOptions& opt) {
+  auto rec = Recording::open(recording_dir);
+  if (!rec) return rec.error();
+  auto proc = FrameProcessor::create(rec->rig(), targets, nullptr, opt.config);
+  if (!proc) return proc.error();
+
+  CollectedCalibration result;
+  FrameOutput out = proc->make_output();
+  std::array<Image, 2> images;
+  const auto& frames = rec->frames();
+  for (std::size_t fi = 0; fi < frames.size(); ++fi) {
+    const FrameEntry& fe = frames[fi];
+    std::array<ImageView, 2> views;
+    std::array<const ImageView*, 2> present{nullptr, nullptr};
+    for (std::size_t c = 0; c < 2; ++c) {
+      auto loaded = rec->load_frame(static_cast<int>(c), fe.frame, images[c]);
+      if (!loaded) {
+        if (opt.warn) opt.warn(loaded.error().message + " (frame " + std::to_string(fe.frame) + " skipped)");
+      } else if (*loaded == FrameLoad::kOk) {
+        views[c] = images[c].view();
+        present[c] = &views[c];
+      }
+    }
+    proc->process(present[0], present[1], fe.timestamp_ns, out);
+    ++result.frames;
+
+    kinematics::CalibrationFrame frame;
+    frame.bodies.resize(targets.bodies.size());
+    int found = 0;
+    for (std::size_t b = 0; b < targets.bodies.size(); ++b) {
+      const BodyPose& pose = out.poses.bodies[b];
+      kinematics::BodyObservation& obs = frame.bodies[b];
+      obs.found = pose.found;
+      if (!pose.found) continue;
+      ++found;
+      obs.T_world_body = pose.T_world_body;
+      for (std::size_t k = 0; k < targets.bodies[b].markers_body.size(); ++k) {
+        const std::int16_t idx = pose.point_index_of_marker[k];
+        if (idx < 0 || idx >= out.points.size()) continue;
+        obs.markers.push_back({static_cast<int>(k), out.points[idx].X_world});
+      }
+    }
+    if (found == static_cast<int>(targets.bodies.size())) ++result.frames_all_bodies;
+    result.input.frames.push_back(std::move(frame));
+    if (opt.progress) opt.progress(static_cast<std::int64_t>(fi + 1), static_cast<std::int64_t>(frames.size()));
+  }
+  return result;
+}
+
+}  // namespace mocap

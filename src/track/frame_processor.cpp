@@ -1,0 +1,137 @@
+#include "track/frame_processor.h"
+
+#include <algorithm>
+#include <utility>
+
+#include "core/latency_stats.h"
+
+namespace mocap {
+
+Expected<FrameProcessor> FrameProcessor::create(const Rig& rig, const TargetSet& targets,
+                                                const JointModel* model,
+                                                const TrackerConfig& config) {
+  if (rig.cameras.size() < 2) {
+    return Error{"rig: the tracker needs two cameras (the stereo pair), the rig has " +
+                 std::to_string(rig.cameras.size())};
+  }
+  std::array<std::optional<detect::BlobDetector>, 2> dets;
+  for (int c = 0; c < 2; ++c) {
+    const CameraModel& cam = rig.cameras[static_cast<std::size_t>(c)];
+    auto d = detect::BlobDetector::create(config.detect, cam.width, cam.height);
+    if (!d) return Error{"detection (" + cam.name + "): " + d.error().message};
+    dets[static_cast<std::size_t>(c)].emplace(std::move(d).value());
+  }
+  auto stereo = StereoTriangulator::create(rig, config.stereo, 0, 1);
+  if (!stereo) return Error{"stereo: " + stereo.error().message};
+  auto ident = Identifier::create(targets, config.identify);
+  if (!ident) return Error{"identification: " + ident.error().message};
+
+  std::optional<kinematics::JointAngleSolver> angles;
+  JointModel model_copy;
+  if (model != nullptr) {
+    auto solver = kinematics::JointAngleSolver::create(*model, targets.bodies.size());
+    if (!solver) return Error{"joint angles: " + solver.error().message};
+    angles.emplace(std::move(solver).value());
+    model_copy = *model;
+  }
+  FrameProcessor p(rig, targets, std::move(model_copy),
+                   {std::move(*dets[0]), std::move(*dets[1])}, std::move(stereo).value(),
+                   std::move(ident).value(), std::move(angles));
+  for (auto& c : p.centroids_px_) c.resize(static_cast<std::size_t>(config.detect.max_blobs));
+  p.measured_.resize(static_cast<std::size_t>(std::max(1, config.stereo.max_candidates)));
+  p.body_views_.resize(targets.bodies.size());
+  return p;
+}
+
+FrameProcessor::FrameProcessor(Rig rig, TargetSet targets, JointModel model,
+                               std::array<detect::BlobDetector, 2> detectors,
+                               StereoTriangulator stereo, Identifier identifier,
+                               std::optional<kinematics::JointAngleSolver> angles)
+    : rig_(std::move(rig)),
+      targets_(std::move(targets)),
+      model_(std::move(model)),
+      detectors_(std::move(detectors)),
+      stereo_(std::move(stereo)),
+      identifier_(std::move(identifier)),
+      angles_(std::move(angles)) {}
+
+FrameOutput FrameProcessor::make_output() const {
+  FrameOutput out;
+  for (std::size_t c = 0; c < 2; ++c) out.blobs[c] = detectors_[c].make_blob_list();
+  out.points.set_capacity(stereo_.config().max_candidates);
+  out.poses.count = identifier_.body_count();
+  if (angles_) out.angles = angles_->make_output();
+  return out;
+}
+
+bool FrameProcessor::detect_camera(int camera, const ImageView& image,
+                                   detect::BlobList& out) noexcept {
+  if (camera < 0 || camera > 1) return false;
+  return detectors_[static_cast<std::size_t>(camera)].detect(image, out);
+}
+
+bool FrameProcessor::process(const ImageView* cam0, const ImageView* cam1,
+                             std::int64_t timestamp_ns, FrameOutput& out) noexcept {
+  const std::int64_t t0 = monotonic_ns();
+  const ImageView* views[2] = {cam0, cam1};
+  for (std::size_t c = 0; c < 2; ++c) {
+    out.blobs[c].clear();
+    out.camera_present[c] = views[c] != nullptr;
+    if (views[c] != nullptr) detect_camera(static_cast<int>(c), *views[c], out.blobs[c]);
+  }
+  out.times.detect = monotonic_ns() - t0;
+  const bool ok = process_blobs(timestamp_ns, out);
+  out.times.frame = monotonic_ns() - t0;
+  return ok;
+}
+
+bool FrameProcessor::process_blobs(std::int64_t timestamp_ns, FrameOutput& out) noexcept {
+  // Stereo + triangulation: only when both cameras delivered this frame.
+  std::int64_t t = monotonic_ns();
+  out.points.clear();
+  if (out.camera_present[0] && out.camera_present[1]) {
+    std::array<int, 2> n{};
+    for (std::size_t c = 0; c < 2; ++c) {
+      const detect::BlobList& blobs = out.blobs[c];
+      std::vector<Vec2>& px = centroids_px_[c];
+      const std::size_t count = std::min(blobs.size(), px.size());
+      for (std::size_t i = 0; i < count; ++i) px[i] = Vec2(blobs[i].x_px, blobs[i].y_px);
+      n[c] = static_cast<int>(count);
+    }
+    stereo_.process(centroids_px_[0].data(), n[0], centroids_px_[1].data(), n[1], out.points);
+  }
+  std::int64_t now = monotonic_ns();
+  out.times.triangulate = now - t;
+
+  // Identification.
+  t = now;
+  const int n_points = std::min(out.points.size(), static_cast<int>(measured_.size()));
+  for (int i = 0; i < n_points; ++i) {
+    const Point3& p = out.points[i];
+    MeasuredPoint& m = measured_[static_cast<std::size_t>(i)];
+    m.X_world = p.X_world;
+    m.blob_index = {p.blob_index[0], p.blob_index[1]};
+  }
+  const bool identified = identifier_.identify(measured_.data(), n_points, timestamp_ns, out.poses);
+  now = monotonic_ns();
+  out.times.identify = now - t;
+
+  // Joint angles.
+  t = now;
+  if (angles_) {
+    for (std::size_t b = 0; b < body_views_.size(); ++b) {
+      body_views_[b].found = out.poses.bodies[b].found;
+      body_views_[b].T_world_body = out.poses.bodies[b].T_world_body;
+    }
+    angles_->compute(body_views_.data(), out.angles);
+  }
+  out.times.angles = monotonic_ns() - t;
+  return identified;
+}
+
+void FrameProcessor::reset() noexcept {
+  identifier_.reset();
+  if (angles_) angles_->reset();
+}
+
+}  // namespace mocap

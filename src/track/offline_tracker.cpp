@@ -1,0 +1,196 @@
+#include "track/offline_tracker.h"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include "core/rotation.h"
+#include "formats/csv_outputs.h"
+#include "formats/joints_yaml.h"
+#include "formats/recording.h"
+#include "formats/targets_yaml.h"
+
+namespace mocap {
+namespace {
+
+constexpr double kRadToDeg = 180.0 / M_PI;
+
+// A point goes to points.csv unless it is an epipolar-ambiguous candidate that no body
+// used: such candidates are kept only for identification to choose from.
+void mark_used_points(const FrameOutput& out, std::vector<char>& used) {
+  std::fill(used.begin(), used.end(), 0);
+  for (int b = 0; b < out.poses.count; ++b) {
+    const BodyPose& body = out.poses.bodies[static_cast<std::size_t>(b)];
+    if (!body.found) continue;
+    for (std::int16_t idx : body.point_index_of_marker) {
+      if (idx >= 0 && static_cast<std::size_t>(idx) < used.size()) used[static_cast<std::size_t>(idx)] = 1;
+    }
+  }
+}
+
+}  // namespace
+
+Expected<OfflineTrackResult> track_recording(const OfflineTrackOptions& opt) {
+  auto rec = Recording::open(opt.recording_dir);
+  if (!rec) return rec.error();
+  auto targets = load_targets(opt.targets_path);
+  if (!targets) return targets.error();
+  std::optional<JointModel> model;
+  if (!opt.model_path.empty()) {
+    auto m = load_model(opt.model_path, *targets);
+    if (!m) return m.error();
+    model = std::move(m).value();
+  }
+  auto proc = FrameProcessor::create(rec->rig(), *targets, model ? &*model : nullptr, opt.config);
+  if (!proc) return proc.error();
+  for (const std::string& w : proc->warnings()) {
+    if (opt.warn) opt.warn(opt.targets_path + ": " + w);
+  }
+
+  std::error_code ec;
+  std::filesystem::create_directories(opt.out_dir, ec);
+  if (ec) return make_error(opt.out_dir, "", "cannot create output folder: " + ec.message());
+  auto points_csv = open_points_csv(opt.out_dir + "/points.csv");
+  if (!points_csv) return points_csv.error();
+  auto poses_csv = open_poses_csv(opt.out_dir + "/poses.csv");
+  if (!poses_csv) return poses_csv.error();
+  std::optional<CsvFile> angles_csv;
+  if (model) {
+    auto a = open_angles_csv(opt.out_dir + "/angles.csv");
+    if (!a) return a.error();
+    angles_csv.emplace(std::move(a).value());
+  }
+
+  const auto& frames = rec->frames();
+  OfflineTrackResult result;
+  result.stats = std::make_unique<TrackStats>(frames.size());
+  for (const MarkerTarget& t : targets->bodies) result.body_names.push_back(t.name);
+  result.body_found.assign(targets->bodies.size(), 0);
+
+  FrameOutput out = proc->make_output();
+  std::vector<char> used(static_cast<std::size_t>(out.points.capacity()), 0);
+  std::array<Image, 2> images;
+  PointRow point_row;
+  PoseRow pose_row;
+  AngleRow angle_row;
+  for (std::size_t fi = 0; fi < frames.size(); ++fi) {
+    const FrameEntry& fe = frames[fi];
+    std::array<const ImageView*, 2> present{nullptr, nullptr};
+    std::array<ImageView, 2> views;
+    bool missing = false, damaged = false;
+    for (int c = 0; c < 2; ++c) {
+      auto loaded = rec->load_frame(c, fe.frame, images[static_cast<std::size_t>(c)]);
+      if (!loaded) {
+        damaged = true;
+        if (opt.warn) opt.warn(loaded.error().message + " (frame " + std::to_string(fe.frame) + " treated as dropped)");
+      } else if (*loaded == FrameLoad::kMissing) {
+        missing = true;
+      } else {
+        views[static_cast<std::size_t>(c)] = images[static_cast<std::size_t>(c)].view();
+        present[static_cast<std::size_t>(c)] = &views[static_cast<std::size_t>(c)];
+      }
+    }
+    result.frames_missing += missing ? 1 : 0;
+    result.frames_damaged += damaged ? 1 : 0;
+
+    proc->process(present[0], present[1], fe.timestamp_ns, out);
+    result.stats->record(out.times);
+    ++result.stats->frames;
+    ++result.frames;
+
+    mark_used_points(out, used);
+    for (int i = 0; i < out.points.size(); ++i) {
+      const Point3& p = out.points[i];
+      if (p.ambiguous && !used[static_cast<std::size_t>(i)]) continue;
+      point_row.frame = fe.frame;
+      point_row.X_world = p.X_world;
+      point_row.reproj_px = p.reproj_px;
+      write_row(*points_csv, point_row);
+      ++result.points;
+    }
+    for (int b = 0; b < out.poses.count; ++b) {
+      const BodyPose& body = out.poses.bodies[static_cast<std::size_t>(b)];
+      if (!body.found) continue;
+      ++result.body_found[static_cast<std::size_t>(b)];
+      pose_row.frame = fe.frame;
+      pose_row.timestamp_ns = fe.timestamp_ns;
+      pose_row.body = targets->bodies[static_cast<std::size_t>(b)].name;
+      pose_row.q_world_body = canonical_quat(body.T_world_body.linear());
+      pose_row.t_world_body = body.T_world_body.translation();
+      pose_row.markers = body.markers;
+      pose_row.rms_mm = body.rms_mm;
+      write_row(*poses_csv, pose_row);
+    }
+    if (angles_csv) {
+      for (std::size_t j = 0; j < out.angles.joints.size(); ++j) {
+        const kinematics::JointAngle& a = out.angles.joints[j];
+        if (!a.valid) continue;
+        angle_row.frame = fe.frame;
+        angle_row.timestamp_ns = fe.timestamp_ns;
+        angle_row.joint = model->joints[j].name;
+        angle_row.type = a.type;
+        angle_row.angles_deg = Vec3(a.a0, a.a1, a.a2) * kRadToDeg;
+        angle_row.q_parent_child = a.q_parent_child;
+        write_row(*angles_csv, angle_row);
+        ++result.angle_rows;
+      }
+    }
+    if (opt.progress) opt.progress(static_cast<std::int64_t>(fi + 1), static_cast<std::int64_t>(frames.size()));
+  }
+
+  if (auto r = points_csv->close(); !r) return r.error();
+  if (auto r = poses_csv->close(); !r) return r.error();
+  if (angles_csv) {
+    if (auto r = angles_csv->close(); !r) return r.error();
+  }
+  result.stats->counters = collect_counters(*proc);
+  if (!opt.stats_path.empty()) {
+    if (auto r = write_stats_json(opt.stats_path, *result.stats); !r) return r.error();
+  }
+  if (!opt.truth_dir.empty()) {
+    auto gt = load_ground_truth(opt.truth_dir);
+    if (!gt) return gt.error();
+    auto pts = read_points_csv(opt.out_dir + "/points.csv");
+    if (!pts) return pts.error();
+    auto poses = read_poses_csv(opt.out_dir + "/poses.csv");
+    if (!poses) return poses.error();
+    std::vector<AngleRow> angles;
+    if (model) {
+      auto a = read_angles_csv(opt.out_dir + "/angles.csv");
+      if (!a) return a.error();
+      angles = std::move(a).value();
+    }
+    result.accuracy = evaluate_against_truth(*gt, *pts, *poses, angles);
+  }
+  return result;
+}
+
+std::string format_track_summary(const OfflineTrackResult& r) {
+  std::string s;
+  char buf[256];
+  std::snprintf(buf, sizeof buf, "tracked %lld frames (%lld with a missing camera frame, %lld damaged), %lld 3D points\n",
+                static_cast<long long>(r.frames), static_cast<long long>(r.frames_missing),
+                static_cast<long long>(r.frames_damaged), static_cast<long long>(r.points));
+  s += buf;
+  for (std::size_t b = 0; b < r.body_names.size(); ++b) {
+    std::snprintf(buf, sizeof buf, "  %-10s found in %lld frames (%.1f%%)\n", r.body_names[b].c_str(),
+                  static_cast<long long>(r.body_found[b]),
+                  r.frames ? 100.0 * static_cast<double>(r.body_found[b]) / static_cast<double>(r.frames) : 0.0);
+    s += buf;
+  }
+  if (r.stats) {
+    const std::pair<const char*, const LatencyRecorder*> stages[] = {
+        {"detect", &r.stats->detect}, {"triangulate", &r.stats->triangulate},
+        {"identify", &r.stats->identify}, {"angles", &r.stats->angles}, {"frame", &r.stats->frame}};
+    s += "  latency per frame (us):       p50        p99        max\n";
+    for (const auto& [name, rec] : stages) {
+      const LatencySummary l = rec->summary();
+      std::snprintf(buf, sizeof buf, "    %-12s %14.1f %10.1f %10.1f\n", name, l.p50_us, l.p99_us, l.max_us);
+      s += buf;
+    }
+  }
+  if (r.accuracy) s += format_accuracy(*r.accuracy);
+  return s;
+}
+
+}  // namespace mocap

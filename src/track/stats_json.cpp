@@ -1,0 +1,78 @@
+#include "track/stats_json.h"
+
+#include <cstdio>
+
+namespace mocap {
+
+std::vector<std::pair<std::string, std::uint64_t>> collect_counters(const FrameProcessor& p) {
+  std::vector<std::pair<std::string, std::uint64_t>> c;
+  for (int cam = 0; cam < 2; ++cam) {
+    const detect::DetectorCounters& d = p.detector_counters(cam);
+    const std::string k = "detect_cam" + std::to_string(cam) + "_";
+    c.emplace_back(k + "frames", d.frames);
+    c.emplace_back(k + "frames_invalid", d.frames_invalid);
+    c.emplace_back(k + "frames_overflow", d.frames_overflow);
+    c.emplace_back(k + "blobs_dropped", d.blobs_dropped);
+    c.emplace_back(k + "rejected_small", d.rejected_small);
+    c.emplace_back(k + "rejected_large", d.rejected_large);
+    c.emplace_back(k + "rejected_elongated", d.rejected_elongated);
+    c.emplace_back(k + "merged", d.merged);
+    c.emplace_back(k + "splits", d.splits);
+  }
+  const StereoCounters& s = p.stereo_counters();
+  c.emplace_back("stereo_frames", s.frames);
+  c.emplace_back("stereo_candidates", s.candidates);
+  c.emplace_back("stereo_ambiguous", s.ambiguous);
+  c.emplace_back("stereo_rejected_reproj", s.rejected_reproj);
+  c.emplace_back("stereo_candidate_overflow", s.candidate_overflow);
+  c.emplace_back("stereo_points_overflow", s.points_overflow[0] + s.points_overflow[1]);
+  const IdentifyCounters& i = p.identify_counters();
+  c.emplace_back("identify_bodies_found", i.bodies_found);
+  c.emplace_back("identify_full_searches", i.full_searches);
+  c.emplace_back("identify_warm_accepted", i.warm_accepted);
+  c.emplace_back("identify_warm_fallbacks", i.warm_fallbacks);
+  c.emplace_back("identify_velocity_rejects", i.velocity_rejects);
+  c.emplace_back("identify_point_overflow", i.point_overflow);
+  c.emplace_back("identify_node_limit_hits", i.node_limit_hits);
+  return c;
+}
+
+std::string stats_to_json(const TrackStats& stats) {
+  std::string out;
+  char buf[256];
+  std::snprintf(buf, sizeof buf, "{\"frames\": %lld,\n \"stages\": {", static_cast<long long>(stats.frames));
+  out += buf;
+  const std::pair<const char*, const LatencyRecorder*> stages[] = {
+      {"detect", &stats.detect},     {"triangulate", &stats.triangulate}, {"identify", &stats.identify},
+      {"angles", &stats.angles},     {"frame", &stats.frame}};
+  bool first = true;
+  for (const auto& [name, rec] : stages) {
+    const LatencySummary s = rec->summary();
+    std::snprintf(buf, sizeof buf,
+                  "%s\n   \"%s\": {\"p50_us\": %.3f, \"p99_us\": %.3f, \"max_us\": %.3f, \"mean_us\": %.3f}",
+                  first ? "" : ",", name, s.p50_us, s.p99_us, s.max_us, s.mean_us);
+    out += buf;
+    first = false;
+  }
+  out += "},\n \"counters\": {";
+  first = true;
+  for (const auto& [name, value] : stats.counters) {
+    std::snprintf(buf, sizeof buf, "%s\n   \"%s\": %llu", first ? "" : ",", name.c_str(),
+                  static_cast<unsigned long long>(value));
+    out += buf;
+    first = false;
+  }
+  out += "}}\n";
+  return out;
+}
+
+Expected<void> write_stats_json(const std::string& path, const TrackStats& stats) {
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  if (f == nullptr) return make_error(path, "", "cannot open for writing");
+  const std::string json = stats_to_json(stats);
+  const bool ok = std::fwrite(json.data(), 1, json.size(), f) == json.size();
+  if (std::fclose(f) != 0 || !ok) return make_error(path, "", "write failed");
+  return {};
+}
+
+}  // namespace mocap

@@ -1,0 +1,71 @@
+// Design: accuracy of the tracker's outputs against the simulator's ground truth
+// (gt/poses.csv, gt/angles.csv, gt/markers.csv; see docs/simulator.md). Used by
+// `mocap track --truth`, the end-to-end tests and the evaluation script. Offline only.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/expected.h"
+#include "core/types.h"
+#include "formats/csv_outputs.h"
+
+namespace mocap {
+
+struct GtMarker {
+  std::int64_t frame = 0;
+  std::string body;
+  int marker = 0;
+  Vec3 X_world = Vec3::Zero();
+  std::array<Vec2, 2> px{Vec2::Zero(), Vec2::Zero()};
+  std::array<bool, 2> visible{false, false};  // visible, unmerged, inside the image
+};
+
+struct GroundTruth {
+  std::vector<PoseRow> poses;
+  std::vector<AngleRow> angles;
+  std::vector<GtMarker> markers;  // sorted by frame
+};
+
+// Reads DIR/poses.csv, DIR/angles.csv (optional) and DIR/markers.csv.
+Expected<GroundTruth> load_ground_truth(const std::string& gt_dir);
+Expected<std::vector<GtMarker>> read_gt_markers_csv(const std::string& path);
+
+struct BodyAccuracy {
+  std::string body;
+  std::int64_t frames_visible = 0;  // frames with >= 3 of its markers visible in both cameras
+  std::int64_t frames_found = 0;    // of those, frames where the tracker found the body
+  std::int64_t frames_found_total = 0;
+  std::int64_t wrong = 0;           // found with a pose far from the truth (> 10 mm or > 5 deg)
+  double position_rms_mm = 0.0;     // over correct finds
+  double rotation_rms_deg = 0.0;
+};
+
+struct JointAccuracy {
+  std::string joint;
+  std::int64_t frames = 0;
+  double rms_deg = 0.0;  // ball: geodesic angle of the relative rotation; hinge: angle
+  double max_deg = 0.0;
+};
+
+struct AccuracyReport {
+  std::int64_t frames = 0;
+  std::int64_t marker_views = 0;     // markers visible in both cameras, summed over frames
+  std::int64_t markers_recalled = 0;  // of those, with a 3D point within 2 mm
+  double point_rmse_mm = 0.0;         // over recalled markers
+  std::int64_t points = 0;            // all 3D points written
+  std::int64_t points_far = 0;        // points farther than 5 mm from every true marker
+  std::vector<BodyAccuracy> bodies;
+  std::vector<JointAccuracy> joints;
+};
+
+AccuracyReport evaluate_against_truth(const GroundTruth& truth, const std::vector<PointRow>& points,
+                                      const std::vector<PoseRow>& poses,
+                                      const std::vector<AngleRow>& angles);
+
+// Human-readable multi-line summary.
+std::string format_accuracy(const AccuracyReport& report);
+
+}  // namespace mocap
