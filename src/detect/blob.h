@@ -1,0 +1,93 @@
+// Design: the detector's output types. A Blob is one marker image: sub-pixel
+// centroid (pixel centre of the top-left pixel = (0,0), as in camera/camera_model.h),
+// size, bounding box, peak and second-moment shape, plus flags. BlobList is a
+// fixed-capacity array whose storage is allocated once at setup; the hot path only
+// overwrites it and counts what did not fit. DetectorCounters accumulate over the
+// detector's lifetime (failures become counters, never exceptions or logs).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace mocap::detect {
+
+// Bit flags of Blob::flags.
+enum BlobFlag : std::uint32_t {
+  kBlobTouchesBorder = 1u << 0,  // has a pixel on the image (or ROI) border: may be cut off
+  kBlobSaturated = 1u << 1,      // peak reached the image's maxval
+  kBlobMerged = 1u << 2,         // looks like two overlapping markers (elongated, two maxima)
+  kBlobSplit = 1u << 3,          // one of two blobs produced by splitting a merged blob
+  kBlobTruncated = 1u << 4,      // the run buffer overflowed while this blob was open
+};
+
+struct Blob {
+  double x_px = 0.0;     // sub-pixel centroid (column), background-subtracted intensity-weighted
+  double y_px = 0.0;     // sub-pixel centroid (row)
+  float area_px = 0.0f;  // pixels at or above threshold (after a split: this part's share)
+  float sum_dn = 0.0f;   // sum of (pixel - background) over the centroid's pixels
+  std::uint16_t peak_dn = 0;                       // brightest pixel value (raw DN)
+  std::uint16_t background_dn = 0;                 // background level used for the weights
+  int x_min = 0, y_min = 0, x_max = 0, y_max = 0;  // inclusive bounding box (pixels)
+  float major_axis_px = 0.0f;    // 2*sqrt(largest eigenvalue of the weighted covariance)
+  float minor_axis_px = 0.0f;    // 2*sqrt(smallest eigenvalue)
+  float roundness = 0.0f;        // minor/major in (0, 1]; 1 = circle
+  float eccentricity = 0.0f;     // sqrt(1 - (minor/major)^2); 0 = circle
+  float orientation_rad = 0.0f;  // major-axis angle from +x towards +y, in (-pi/2, pi/2]
+  std::uint32_t flags = 0;       // BlobFlag bits
+
+  bool has(BlobFlag f) const noexcept { return (flags & f) != 0; }
+};
+
+// Fixed-capacity list of blobs; capacity chosen at setup, never grows in the hot path.
+class BlobList {
+ public:
+  BlobList() = default;
+  explicit BlobList(std::size_t capacity) : storage_(capacity) {}
+
+  std::size_t size() const noexcept { return size_; }
+  std::size_t capacity() const noexcept { return storage_.size(); }
+  bool empty() const noexcept { return size_ == 0; }
+  const Blob& operator[](std::size_t i) const noexcept { return storage_[i]; }
+  Blob& operator[](std::size_t i) noexcept { return storage_[i]; }
+  const Blob* begin() const noexcept { return storage_.data(); }
+  const Blob* end() const noexcept { return storage_.data() + size_; }
+
+  void clear() noexcept { size_ = 0; }
+  // Appends when there is room; returns false (nothing written) when full.
+  bool push(const Blob& b) noexcept {
+    if (size_ >= storage_.size()) return false;
+    storage_[size_++] = b;
+    return true;
+  }
+
+ private:
+  std::vector<Blob> storage_;
+  std::size_t size_ = 0;
+};
+
+// Lifetime counters (monotonic). The last frame's values are in last_* fields.
+struct DetectorCounters {
+  std::uint64_t frames = 0;
+  std::uint64_t frames_invalid = 0;      // wrong size/format/null data: nothing detected
+  std::uint64_t frames_no_contrast = 0;  // threshold above maxval (e.g. all white): no blobs
+  std::uint64_t frames_overflow = 0;     // frames with run or blob overflow
+  std::uint64_t runs_overflow = 0;       // frames whose run buffer filled (scan stopped early)
+  std::uint64_t blobs_dropped = 0;       // accepted blobs that did not fit the BlobList
+  std::uint64_t components = 0;          // connected components found
+  std::uint64_t rejected_small = 0;
+  std::uint64_t rejected_large = 0;
+  std::uint64_t rejected_elongated = 0;
+  std::uint64_t rejected_border = 0;
+  std::uint64_t merged = 0;  // components flagged as merged
+  std::uint64_t splits = 0;  // merged components split into two blobs
+  // Last frame.
+  std::uint32_t last_runs = 0;
+  std::uint32_t last_components = 0;
+  std::uint32_t last_blobs = 0;
+  double last_background_dn = 0.0;
+  double last_noise_dn = 0.0;
+  std::uint32_t last_threshold_dn = 0;
+};
+
+}  // namespace mocap::detect
