@@ -17,6 +17,8 @@ packages=(
   libcamera-dev linux-libc-dev libv4l-dev
   # service integration and tools used by tests
   libsystemd-dev systemd liburdfdom-tools python3
+  # header-only baseline of the ring-buffer benchmark
+  libboost-dev
   # the OpenCV comparison baseline of bench/ (never linked by the product)
   libopencv-dev
 )
