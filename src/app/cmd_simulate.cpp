@@ -23,19 +23,23 @@ void register_simulate(CLI::App& app, int& exit_code) {
       "simulate", "Write a synthetic stereo recording of the shoulder test rig with ground truth");
   cmd->add_option("--out", args->out, "Output folder (created if needed)")->required();
   cmd->add_option("--frames", args->opt.frames, "Number of frames (default 100)");
-  cmd->add_option("--motion", args->motion, "smooth | poses | move400 | viewpoints (default smooth)");
+  cmd->add_option("--motion", args->motion,
+                  "smooth | poses | move400 | viewpoints (default smooth)");
   cmd->add_option("--seed", args->seed, "Random seed of noise, drop-outs and strays (default 1)");
   cmd->add_option("--noise", args->opt.noise_dn,
                   "Read noise sigma in output DN (default 1.5 at 8 bits, scaled for 16 bits)");
-  cmd->add_option("--blur", args->opt.blur_px, "Optical blur (Gaussian PSF) sigma in px (default 0.5)");
+  cmd->add_option("--blur", args->opt.blur_px,
+                  "Optical blur (Gaussian PSF) sigma in px (default 0.5)");
   cmd->add_option("--stray", args->opt.stray, "Number of shiny spots causing glints (default 0)");
-  cmd->add_flag("--streak", args->opt.streak, "Add a bright elongated reflection along the lower arm");
+  cmd->add_flag("--streak", args->opt.streak,
+                "Add a bright elongated reflection along the lower arm");
   cmd->add_option("--dropout", args->opt.dropout,
                   "Probability that a marker is missing in a camera's frame (default 0)");
   cmd->add_option("--bits", args->opt.bits, "8 or 16 (default 8)");
   cmd->add_option("--maxval", args->opt.maxval, "16-bit maxval, 256..65535 (default 4095)");
   cmd->add_option("--fps", args->opt.fps, "Frame rate for the timestamps (default 100)");
-  cmd->add_option("--poses", args->opt.poses, "Number of static poses of --motion poses (default 22)");
+  cmd->add_option("--poses", args->opt.poses,
+                  "Number of static poses of --motion poses (default 22)");
   cmd->add_option("--threads", args->opt.threads, "Rendering threads, 1 or 2 (default 2)");
   cmd->callback([args, &exit_code]() {
     auto motion = sim::parse_motion(args->motion);
@@ -54,7 +58,8 @@ void register_simulate(CLI::App& app, int& exit_code) {
       return;
     }
     std::printf(
-        "simulate: wrote %d frames x %d cameras (%s) to %s in %.2f s: %lld isolated, %lld occluded, "
+        "simulate: wrote %d frames x %d cameras (%s) to %s in %.2f s: %lld isolated, %lld "
+        "occluded, "
         "%lld dropped marker views, %lld glints\n",
         r->frames, r->cameras, sim::motion_name(args->opt.motion), args->out.c_str(), r->seconds,
         static_cast<long long>(r->isolated_views), static_cast<long long>(r->occluded_views),
