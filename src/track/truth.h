@@ -11,6 +11,8 @@
 #include "core/expected.h"
 #include "core/types.h"
 #include "formats/csv_outputs.h"
+#include "formats/joints_yaml.h"
+#include "formats/targets_yaml.h"
 
 namespace mocap {
 
@@ -29,8 +31,14 @@ struct GroundTruth {
   std::vector<GtMarker> markers;  // sorted by frame
 };
 
-// Reads DIR/poses.csv, DIR/angles.csv (optional) and DIR/markers.csv.
+// Reads DIR/poses.csv, DIR/angles.csv (optional) and DIR/markers.csv. When DIR holds
+// model_true.yaml (and DIR/../targets.yaml exists), the true joint angles are recomputed
+// from the true poses in the tracker's angle convention (true_angles_from_poses).
 Expected<GroundTruth> load_ground_truth(const std::string& gt_dir);
+// Joint angles of `model` for each frame of `poses` (rows sorted by frame), as the
+// tracker computes them (kinematics::JointAngleSolver).
+Expected<std::vector<AngleRow>> true_angles_from_poses(const TargetSet& targets, const JointModel& model,
+                                                       const std::vector<PoseRow>& poses);
 Expected<std::vector<GtMarker>> read_gt_markers_csv(const std::string& path);
 
 struct BodyAccuracy {

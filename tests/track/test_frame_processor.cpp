@@ -1,0 +1,118 @@
+// Tests of the FrameProcessor: steady-state processing allocates nothing, a missing
+// camera frame yields no 3D points, damaged images never crash.
+#include <gtest/gtest.h>
+
+#include "formats/recording.h"
+#include "formats/targets_yaml.h"
+#include "tests/support/alloc_counter.h"
+#include "tests/track/track_fixture.h"
+#include "track/frame_processor.h"
+
+namespace mocap {
+namespace {
+
+sim::SimOptions small_options() {
+  sim::SimOptions o;
+  o.frames = 12;
+  o.stray = 3;
+  return o;
+}
+
+struct Loaded {
+  Recording rec;
+  TargetSet targets;
+  std::vector<std::array<Image, 2>> images;
+};
+
+Loaded load(const std::string& dir) {
+  auto rec = Recording::open(dir);
+  EXPECT_TRUE(rec.ok());
+  auto targets = load_targets(dir + "/targets.yaml");
+  EXPECT_TRUE(targets.ok());
+  Loaded l{*rec, *targets, {}};
+  for (const FrameEntry& f : rec->frames()) {
+    std::array<Image, 2> imgs;
+    for (int c = 0; c < 2; ++c) {
+      auto r = rec->load_frame(c, f.frame, imgs[static_cast<std::size_t>(c)]);
+      EXPECT_TRUE(r.ok() && *r == FrameLoad::kOk);
+    }
+    l.images.push_back(std::move(imgs));
+  }
+  return l;
+}
+
+TEST(FrameProcessor, SteadyStateProcessingAllocatesNothing) {
+  const std::string& dir = test::simulated_recording("alloc", small_options());
+  Loaded l = load(dir);
+  auto proc = FrameProcessor::create(l.rec.rig(), l.targets, nullptr, TrackerConfig{});
+  ASSERT_TRUE(proc.ok()) << proc.error().message;
+  FrameOutput out = proc->make_output();
+  // Warm up: the first frames may take the cold identification path.
+  for (std::size_t i = 0; i < 4; ++i) {
+    const ImageView v0 = l.images[i][0].view(), v1 = l.images[i][1].view();
+    proc->process(&v0, &v1, l.rec.frames()[i].timestamp_ns, out);
+  }
+  test::AllocationScope scope;
+  int bodies = 0;
+  for (std::size_t i = 4; i < l.images.size(); ++i) {
+    const ImageView v0 = l.images[i][0].view(), v1 = l.images[i][1].view();
+    proc->process(&v0, &v1, l.rec.frames()[i].timestamp_ns, out);
+    bodies += out.poses.found;
+  }
+  proc->reset();  // and the cold path too
+  const ImageView v0 = l.images[0][0].view(), v1 = l.images[0][1].view();
+  proc->process(&v0, &v1, l.rec.frames()[0].timestamp_ns + 1000000000, out);
+  EXPECT_EQ(scope.count(), 0u);
+  EXPECT_GT(bodies, 0);  // the work was real
+}
+
+TEST(FrameProcessor, MissingCameraFrameYieldsNoPoints) {
+  const std::string& dir = test::simulated_recording("alloc", small_options());
+  Loaded l = load(dir);
+  auto proc = FrameProcessor::create(l.rec.rig(), l.targets, nullptr, TrackerConfig{});
+  ASSERT_TRUE(proc.ok());
+  FrameOutput out = proc->make_output();
+  const ImageView v0 = l.images[0][0].view(), v1 = l.images[0][1].view();
+  proc->process(&v0, &v1, 0, out);
+  EXPECT_GT(out.points.size(), 5);
+  proc->process(&v0, nullptr, 10000000, out);
+  EXPECT_EQ(out.points.size(), 0);
+  EXPECT_GT(out.blobs[0].size(), 5u);
+  EXPECT_FALSE(out.camera_present[1]);
+  EXPECT_EQ(out.poses.found, 0);
+  proc->process(&v0, &v1, 20000000, out);  // and it goes on
+  EXPECT_GT(out.points.size(), 5);
+}
+
+TEST(FrameProcessor, DamagedImagesNeverCrash) {
+  const std::string& dir = test::simulated_recording("alloc", small_options());
+  Loaded l = load(dir);
+  auto proc = FrameProcessor::create(l.rec.rig(), l.targets, nullptr, TrackerConfig{});
+  ASSERT_TRUE(proc.ok());
+  FrameOutput out = proc->make_output();
+  const int w = l.rec.rig().cameras[0].width, h = l.rec.rig().cameras[0].height;
+  Image white(w, h, PixelFormat::kMono8, 255), speckle(w, h, PixelFormat::kMono8, 255);
+  std::fill(white.data(), white.data() + white.size_bytes(), 255);
+  std::uint32_t s = 12345;
+  for (std::size_t i = 0; i < speckle.size_bytes(); ++i) {
+    s = s * 1664525u + 1013904223u;
+    speckle.data()[i] = (s >> 24) > 200 ? 255 : 10;
+  }
+  Image wrong_size(17, 5, PixelFormat::kMono8, 255);
+  const ImageView a = white.view(), b = speckle.view(), c = wrong_size.view();
+  proc->process(&a, &a, 0, out);
+  proc->process(&b, &b, 10000000, out);
+  proc->process(&c, &b, 20000000, out);
+  proc->process(&a, &b, 30000000, out);
+  EXPECT_GT(proc->detector_counters(0).frames_invalid + proc->detector_counters(0).frames_overflow +
+                proc->detector_counters(1).frames_overflow,
+            0u);
+  // A good frame afterwards is processed normally.
+  const ImageView v0 = l.images[0][0].view(), v1 = l.images[0][1].view();
+  proc->reset();
+  proc->process(&v0, &v1, 40000000, out);
+  EXPECT_EQ(out.poses.found, 3);
+}
+
+}  // namespace
+}  // namespace mocap

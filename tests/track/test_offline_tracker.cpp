@@ -1,0 +1,122 @@
+// End-to-end tests on simulated recordings: `mocap track` as a library call against
+// the simulator's ground truth (the acceptance figures of the markers-to-3D and the
+// identification stages), the spec's output files, stats.json, missing and damaged
+// frame files.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "formats/csv_outputs.h"
+#include "formats/recording.h"
+#include "tests/track/track_fixture.h"
+#include "track/offline_tracker.h"
+
+namespace mocap {
+namespace {
+
+OfflineTrackResult track_or_fail(const std::string& rec, const std::string& out, bool truth,
+                                 std::vector<std::string>* warnings = nullptr) {
+  OfflineTrackOptions o;
+  o.recording_dir = rec;
+  o.targets_path = rec + "/targets.yaml";
+  o.out_dir = out;
+  o.stats_path = out + "/stats.json";
+  if (truth) o.truth_dir = rec + "/gt";
+  o.warn = [warnings](const std::string& m) {
+    if (warnings) warnings->push_back(m);
+  };
+  auto r = track_recording(o);
+  EXPECT_TRUE(r.ok()) << (r.ok() ? "" : r.error().message);
+  return r.ok() ? std::move(r).value() : OfflineTrackResult{};
+}
+
+TEST(OfflineTracker, SmoothMotionMeetsTheAccuracyTargets) {
+  sim::SimOptions so;
+  so.frames = 150;
+  const std::string& rec = test::simulated_recording("smooth", so);
+  test::TempDir out("track_out");
+  OfflineTrackResult r = track_or_fail(rec, out.path(), true);
+  ASSERT_TRUE(r.accuracy.has_value());
+  const AccuracyReport& a = *r.accuracy;
+  std::printf("%s", format_track_summary(r).c_str());
+  // Markers cleanly visible in both cameras: recall >= 99.5 %, 3D RMSE <= 0.1 mm.
+  ASSERT_GT(a.marker_views, 500);
+  EXPECT_GE(static_cast<double>(a.markers_recalled), 0.995 * static_cast<double>(a.marker_views));
+  EXPECT_LE(a.point_rmse_mm, 0.1);
+  // Each body found in >= 99.5 % of the frames where >= 3 of its markers are seen by
+  // both cameras, never with a wrong identity.
+  for (const BodyAccuracy& b : a.bodies) {
+    SCOPED_TRACE(b.body);
+    EXPECT_GE(static_cast<double>(b.frames_found), 0.995 * static_cast<double>(b.frames_visible));
+    EXPECT_EQ(b.wrong, 0);
+  }
+}
+
+TEST(OfflineTracker, NoPointsFromNoiseAlone) {
+  // A recording with the markers dropped everywhere: noise (and nothing else) in the images.
+  sim::SimOptions so;
+  so.frames = 20;
+  so.dropout = 1.0;
+  so.noise_dn = 4.0;
+  const std::string& rec = test::simulated_recording("noise_only", so);
+  test::TempDir out("track_noise");
+  OfflineTrackResult r = track_or_fail(rec, out.path(), false);
+  EXPECT_EQ(r.frames, 20);
+  EXPECT_EQ(r.points, 0);
+}
+
+TEST(OfflineTracker, WritesTheSpecFilesAndStats) {
+  sim::SimOptions so;
+  so.frames = 12;
+  so.stray = 3;
+  const std::string& rec = test::simulated_recording("alloc", so);
+  test::TempDir out("track_files");
+  OfflineTrackResult r = track_or_fail(rec, out.path(), false);
+  EXPECT_EQ(r.frames, 12);
+  const std::string points = test::read_file(out.file("points.csv"));
+  const std::string poses = test::read_file(out.file("poses.csv"));
+  EXPECT_EQ(points.rfind("frame,x,y,z,reproj_px\n", 0), 0u);
+  EXPECT_EQ(poses.rfind("frame,timestamp_ns,body,qw,qx,qy,qz,tx,ty,tz,markers,rms_mm\n", 0), 0u);
+  EXPECT_FALSE(std::filesystem::exists(out.file("angles.csv")));  // no model given
+  auto rows = read_poses_csv(out.file("poses.csv"));
+  ASSERT_TRUE(rows.ok());
+  EXPECT_GE(rows->size(), 12u * 2u);
+  for (const PoseRow& p : *rows) EXPECT_GE(p.q_world_body.w(), 0.0);
+  const std::string stats = test::read_file(out.file("stats.json"));
+  for (const char* key : {"\"frames\": 12", "\"detect\"", "\"triangulate\"", "\"identify\"", "\"angles\"",
+                          "\"frame\"", "\"p50_us\"", "\"p99_us\"", "\"max_us\""}) {
+    EXPECT_NE(stats.find(key), std::string::npos) << key;
+  }
+}
+
+TEST(OfflineTracker, MissingAndDamagedFramesAreDroppedNotFatal) {
+  sim::SimOptions so;
+  so.frames = 12;
+  so.stray = 3;
+  const std::string& src = test::simulated_recording("alloc", so);
+  test::TempDir tmp("track_damaged");
+  const std::string rec = tmp.path() + "/rec";
+  std::filesystem::copy(src, rec, std::filesystem::copy_options::recursive);
+  std::filesystem::remove(frame_file_path(rec, "cam1", 3));             // dropped frame
+  test::write_file(frame_file_path(rec, "cam0", 5), "P5\n1032 776\n255\n\x01\x02");  // truncated
+  test::write_file(frame_file_path(rec, "cam1", 7), "");                              // empty
+  std::vector<std::string> warnings;
+  OfflineTrackResult r = track_or_fail(rec, tmp.path() + "/out", false, &warnings);
+  EXPECT_EQ(r.frames, 12);
+  EXPECT_EQ(r.frames_missing, 1);
+  EXPECT_EQ(r.frames_damaged, 2);
+  ASSERT_EQ(warnings.size(), 2u);
+  EXPECT_NE(warnings[0].find("cam0/000005.pgm"), std::string::npos) << warnings[0];
+  EXPECT_NE(warnings[1].find("cam1/000007.pgm"), std::string::npos) << warnings[1];
+  auto points = read_points_csv(tmp.path() + "/out/points.csv");
+  ASSERT_TRUE(points.ok());
+  int in_bad_frames = 0, in_good_frames = 0;
+  for (const PointRow& p : *points) {
+    (p.frame == 3 || p.frame == 5 || p.frame == 7 ? in_bad_frames : in_good_frames) += 1;
+  }
+  EXPECT_EQ(in_bad_frames, 0);
+  EXPECT_GT(in_good_frames, 9 * 8);
+}
+
+}  // namespace
+}  // namespace mocap

@@ -1,0 +1,69 @@
+// Tests of the `mocap track` and `mocap calibrate` command lines: help, one-line errors
+// naming the file, and a run that writes the outputs.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "tests/track/track_fixture.h"
+
+namespace mocap {
+namespace {
+
+int count_lines(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
+
+TEST(TrackCli, HelpListsTheSpecOptions) {
+  const test::RunResult r = test::run_mocap("track --help");
+  EXPECT_EQ(r.exit_code, 0);
+  for (const char* opt : {"--targets", "--model", "--out", "--stats"}) {
+    EXPECT_NE(r.output.find(opt), std::string::npos) << opt;
+  }
+}
+
+TEST(TrackCli, MissingRecordingIsAOneLineError) {
+  test::TempDir tmp("cli_missing");
+  test::write_file(tmp.file("targets.yaml"), "bodies: []\n");
+  const test::RunResult r = test::run_mocap("track " + tmp.file("nope") + " --targets " +
+                                            tmp.file("targets.yaml") + " --out " + tmp.file("out"));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(count_lines(r.output), 1) << r.output;
+  EXPECT_NE(r.output.find("nope"), std::string::npos) << r.output;
+}
+
+TEST(TrackCli, BrokenTargetsFileIsAOneLineError) {
+  sim::SimOptions so;
+  so.frames = 12;
+  so.stray = 3;
+  const std::string& rec = test::simulated_recording("alloc", so);
+  test::TempDir tmp("cli_targets");
+  test::write_file(tmp.file("targets.yaml"), "bodies:\n  - name: a\n    markers: [[0, 0, 0], [1, 2]]\n");
+  const test::RunResult r =
+      test::run_mocap("track " + rec + " --targets " + tmp.file("targets.yaml") + " --out " + tmp.file("out"));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(count_lines(r.output), 1) << r.output;
+  EXPECT_NE(r.output.find("targets.yaml"), std::string::npos) << r.output;
+}
+
+TEST(TrackCli, TracksAndCalibratesASimulatedRecording) {
+  sim::SimOptions so;
+  so.frames = 60;
+  so.motion = sim::MotionKind::kPoses;
+  const std::string& rec = test::simulated_recording("poses", so);
+  test::TempDir tmp("cli_run");
+  const test::RunResult cal = test::run_mocap("calibrate " + rec + " --targets " + rec + "/targets.yaml --joints " +
+                                              rec + "/joints.yaml --out " + tmp.file("model.yaml"));
+  ASSERT_EQ(cal.exit_code, 0) << cal.output;
+  const test::RunResult r = test::run_mocap("track " + rec + " --targets " + rec + "/targets.yaml --model " +
+                                            tmp.file("model.yaml") + " --out " + tmp.file("out") + " --stats " +
+                                            tmp.file("out/stats.json"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  for (const char* f : {"points.csv", "poses.csv", "angles.csv", "stats.json"}) {
+    EXPECT_TRUE(std::filesystem::exists(tmp.file(std::string("out/") + f))) << f;
+  }
+  const std::string angles = test::read_file(tmp.file("out/angles.csv"));
+  EXPECT_EQ(angles.rfind("frame,timestamp_ns,joint,type,a0,a1,a2,qw,qx,qy,qz\n", 0), 0u);
+  EXPECT_NE(angles.find(",elbow,hinge,"), std::string::npos);
+  EXPECT_NE(angles.find(",shoulder,ball,"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace mocap
