@@ -19,6 +19,8 @@ packages=(
   libsystemd-dev systemd liburdfdom-tools python3
   # header-only baseline of the ring-buffer benchmark
   libboost-dev
+  # CRC-32 reference of the client tests, and the plots of the evaluation script
+  zlib1g-dev gnuplot-nox
   # the OpenCV comparison baseline of bench/ (never linked by the product)
   libopencv-dev
 )
