@@ -1,0 +1,245 @@
+// Design: see stereo_triangulator.h. Why the plane-angle window is exact: let r be the
+// unit ray of blob i (camera a) and theta its epipolar plane angle about the baseline,
+// rho = |r x baseline_dir| its distance from the baseline direction. The plane of
+// another blob at angle theta' makes the angle phi with r, sin(phi) = rho |sin(theta -
+// theta')|. In undistorted pixels the distance of blob i to that epipolar line is at
+// least min(fx, fy) * sin(phi) (normalised distance >= sin(phi) since |(x, y, 1)| >= 1).
+// So d_a <= tol implies |sin(theta - theta')| <= tol / (min(fx, fy) * rho): with theta
+// taken modulo pi, a window of half-width asin(that) around theta contains every pair
+// within tolerance; the exact symmetric test then decides.
+#include "stereo/stereo_triangulator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <string>
+
+namespace mocap {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+bool finite(double v) { return std::isfinite(v); }
+
+}  // namespace
+
+Expected<StereoTriangulator> StereoTriangulator::create(const Rig& rig, const StereoConfig& c,
+                                                        int cam_a, int cam_b) {
+  const auto n_cams = static_cast<int>(rig.cameras.size());
+  if (cam_a < 0 || cam_b < 0 || cam_a >= n_cams || cam_b >= n_cams || cam_a == cam_b ||
+      cam_a >= kMaxCameras || cam_b >= kMaxCameras)
+    return make_error("stereo", "cameras",
+                      "pair (" + std::to_string(cam_a) + ", " + std::to_string(cam_b) +
+                          ") invalid for a rig of " + std::to_string(n_cams) + " cameras");
+  if (!(finite(c.epipolar_tolerance_px) && c.epipolar_tolerance_px > 0.0))
+    return make_error("stereo", "epipolar_tolerance_px", "must be a positive number");
+  if (!(finite(c.max_reproj_px) && c.max_reproj_px > 0.0))
+    return make_error("stereo", "max_reproj_px", "must be a positive number");
+  if (!(finite(c.min_depth_mm) && c.min_depth_mm >= 0.0))
+    return make_error("stereo", "min_depth_mm", "must be a non-negative number");
+  if (!(finite(c.max_depth_mm) && c.max_depth_mm > c.min_depth_mm))
+    return make_error("stereo", "max_depth_mm", "must be a number above min_depth_mm");
+  if (c.max_points_per_camera < 1 || c.max_points_per_camera > 32767)
+    return make_error("stereo", "max_points_per_camera", "must be in [1, 32767]");
+  if (c.max_candidates < 1) return make_error("stereo", "max_candidates", "must be >= 1");
+
+  const CameraModel& ca = rig.cameras[static_cast<std::size_t>(cam_a)];
+  const CameraModel& cb = rig.cameras[static_cast<std::size_t>(cam_b)];
+  auto geometry = make_stereo_geometry(ca, cb);
+  if (!geometry) return geometry.error();
+
+  StereoTriangulator t;
+  t.config_ = c;
+  t.cam_a_model_ = ca;
+  t.cam_b_model_ = cb;
+  t.geometry_ = *geometry;
+  t.cam_a_ = cam_a;
+  t.cam_b_ = cam_b;
+  // Any unit vector not parallel to the baseline seeds the perpendicular pair.
+  const Vec3& bdir = t.geometry_.baseline_dir_0;
+  Vec3 seed = Vec3::UnitX();
+  if (std::abs(bdir.x()) > 0.9) seed = Vec3::UnitY();
+  t.plane_u_0_ = bdir.cross(seed).normalized();
+  t.plane_v_0_ = bdir.cross(t.plane_u_0_);
+  const auto cap = static_cast<std::size_t>(c.max_points_per_camera);
+  t.obs_a_.resize(cap);
+  t.obs_b_.resize(cap);
+  t.keys_b_.resize(cap);
+  t.use_a_.assign(cap, 0);
+  t.use_b_.assign(cap, 0);
+  return t;
+}
+
+void StereoTriangulator::prepare(const Vec2* px, int n, int camera,
+                                 std::vector<Observation>& obs) noexcept {
+  const CameraModel& cam = camera == 0 ? cam_a_model_ : cam_b_model_;
+  const double f_min = std::min(cam.fx, cam.fy);
+  for (int i = 0; i < n; ++i) {
+    Observation& o = obs[static_cast<std::size_t>(i)];
+    o.px = px[i];
+    o.valid = false;
+    o.theta = 0.0;
+    o.window = kPi;
+    Vec2 xn;
+    if (!finite(o.px.x()) || !finite(o.px.y()) || !undistort_pixel(cam, o.px, xn)) {
+      ++counters_.undistort_failed[static_cast<std::size_t>(camera)];
+      continue;
+    }
+    o.valid = true;
+    o.s = to_scaled(cam, xn);
+    // Unit ray in camera-a coordinates.
+    Vec3 r(xn.x(), xn.y(), 1.0);
+    if (camera == 1) r = geometry_.R_10.transpose() * r;
+    r.normalize();
+    const double p = r.dot(plane_u_0_);
+    const double q = r.dot(plane_v_0_);
+    const double rho = std::hypot(p, q);
+    double theta = std::atan2(q, p);
+    if (theta < 0.0) theta += kPi;
+    if (theta >= kPi) theta -= kPi;
+    o.theta = theta;
+    // Safety margin for rounding: the window only has to be conservative.
+    const double s = config_.epipolar_tolerance_px * (1.0 + 1e-9) / (f_min * rho) + 1e-12;
+    o.window = s >= 1.0 || !finite(s) ? kPi : std::asin(s) + 1e-12;
+  }
+}
+
+void StereoTriangulator::try_pair(int i, int j, PointList& out, int capacity) noexcept {
+  const Observation& a = obs_a_[static_cast<std::size_t>(i)];
+  const Observation& b = obs_b_[static_cast<std::size_t>(j)];
+  double d_a = 0.0, d_b = 0.0;
+  epipolar_distances_px(geometry_, a.s, b.s, d_a, d_b);
+  const double tol = config_.epipolar_tolerance_px;
+  if (!(d_a <= tol && d_b <= tol)) return;
+  ++counters_.pairs_in_tolerance;
+
+  Vec2 sa_c, sb_c;
+  niter2_correct(geometry_.F_s, a.s, b.s, sa_c, sb_c);
+  Vec3 X_a;
+  if (!intersect_rays(geometry_, from_scaled(cam_a_model_, sa_c), from_scaled(cam_b_model_, sb_c),
+                      X_a)) {
+    ++counters_.rejected_degenerate;
+    return;
+  }
+  const double z_a = X_a.z();
+  const double z_b = (geometry_.R_10 * X_a + geometry_.t_10).z();
+  if (!(z_a > 0.0 && z_b > 0.0)) {
+    ++counters_.rejected_cheirality;
+    return;
+  }
+  const double lo = config_.min_depth_mm, hi = config_.max_depth_mm;
+  if (!(z_a >= lo && z_a <= hi && z_b >= lo && z_b <= hi)) {
+    ++counters_.rejected_depth;
+    return;
+  }
+  const Vec3 X_world = geometry_.R_0w.transpose() * (X_a - geometry_.t_0w);
+  double rms_px = 0.0;
+  if (!reprojection_rms_px(cam_a_model_, cam_b_model_, X_world, a.px, b.px, rms_px)) {
+    ++counters_.rejected_cheirality;
+    return;
+  }
+  if (!(rms_px <= config_.max_reproj_px)) {
+    ++counters_.rejected_reproj;
+    return;
+  }
+  ++counters_.candidates;
+  // Counted even when dropped, so the ambiguity flags of emitted ones stay truthful.
+  ++use_a_[static_cast<std::size_t>(i)];
+  ++use_b_[static_cast<std::size_t>(j)];
+  if (out.size() >= capacity) {
+    ++counters_.candidate_overflow;
+    frame_overflow_ = true;
+    return;
+  }
+  Point3 p;
+  p.X_world = X_world;
+  p.reproj_px = rms_px;
+  p.epipolar_px = std::max(d_a, d_b);
+  p.blob_index[static_cast<std::size_t>(cam_a_)] = static_cast<std::int16_t>(i);
+  p.blob_index[static_cast<std::size_t>(cam_b_)] = static_cast<std::int16_t>(j);
+  out.push_back(p);
+}
+
+void StereoTriangulator::scan_range(int i, double lo, double hi, PointList& out,
+                                    int capacity) noexcept {
+  const SortKey* first = keys_b_.data();
+  const SortKey* last = first + n_b_;
+  const SortKey* it =
+      std::lower_bound(first, last, lo, [](const SortKey& k, double v) { return k.theta < v; });
+  for (; it != last && it->theta <= hi; ++it) try_pair(i, it->index, out, capacity);
+}
+
+bool StereoTriangulator::process(const Vec2* px_a, int n_a, const Vec2* px_b, int n_b,
+                                 PointList& out) noexcept {
+  out.clear();
+  ++counters_.frames;
+  frame_overflow_ = false;
+  if (n_a < 0 || n_b < 0 || (n_a > 0 && px_a == nullptr) || (n_b > 0 && px_b == nullptr)) {
+    ++counters_.bad_input;
+    return false;
+  }
+  counters_.points_in[0] += static_cast<std::uint64_t>(n_a);
+  counters_.points_in[1] += static_cast<std::uint64_t>(n_b);
+  const int cap = config_.max_points_per_camera;
+  if (n_a > cap) {
+    counters_.points_overflow[0] += static_cast<std::uint64_t>(n_a - cap);
+    n_a = cap;
+    frame_overflow_ = true;
+  }
+  if (n_b > cap) {
+    counters_.points_overflow[1] += static_cast<std::uint64_t>(n_b - cap);
+    n_b = cap;
+    frame_overflow_ = true;
+  }
+  n_a_ = n_a;
+  n_b_ = n_b;
+  prepare(px_a, n_a, 0, obs_a_);
+  prepare(px_b, n_b, 1, obs_b_);
+  std::fill_n(use_a_.begin(), n_a, std::uint16_t{0});
+  std::fill_n(use_b_.begin(), n_b, std::uint16_t{0});
+  const int capacity = std::min(out.capacity(), config_.max_candidates);
+
+  if (config_.method == MatchMethod::kExhaustive) {
+    for (int i = 0; i < n_a; ++i) {
+      if (!obs_a_[static_cast<std::size_t>(i)].valid) continue;
+      for (int j = 0; j < n_b; ++j)
+        if (obs_b_[static_cast<std::size_t>(j)].valid) try_pair(i, j, out, capacity);
+    }
+  } else {
+    int k = 0;
+    for (int j = 0; j < n_b; ++j) {
+      const Observation& o = obs_b_[static_cast<std::size_t>(j)];
+      if (o.valid) keys_b_[static_cast<std::size_t>(k++)] = SortKey{o.theta, j};
+    }
+    n_b_ = k;
+    std::sort(keys_b_.begin(), keys_b_.begin() + k,
+              [](const SortKey& x, const SortKey& y) { return x.theta < y.theta; });
+    for (int i = 0; i < n_a; ++i) {
+      const Observation& o = obs_a_[static_cast<std::size_t>(i)];
+      if (!o.valid) continue;
+      const double lo = o.theta - o.window;
+      const double hi = o.theta + o.window;
+      if (o.window >= 0.5 * kPi) {
+        scan_range(i, -1.0, 4.0, out, capacity);  // the whole pencil
+      } else if (lo < 0.0) {
+        scan_range(i, 0.0, hi, out, capacity);
+        scan_range(i, lo + kPi, kPi, out, capacity);
+      } else if (hi >= kPi) {
+        scan_range(i, lo, kPi, out, capacity);
+        scan_range(i, 0.0, hi - kPi, out, capacity);
+      } else {
+        scan_range(i, lo, hi, out, capacity);
+      }
+    }
+  }
+
+  for (Point3& p : out) {
+    const auto i = static_cast<std::size_t>(p.blob_index[static_cast<std::size_t>(cam_a_)]);
+    const auto j = static_cast<std::size_t>(p.blob_index[static_cast<std::size_t>(cam_b_)]);
+    p.ambiguous = use_a_[i] > 1 || use_b_[j] > 1;
+    if (p.ambiguous) ++counters_.ambiguous;
+  }
+  return !frame_overflow_;
+}
+
+}  // namespace mocap

@@ -1,0 +1,79 @@
+// Design: the value types the stereo stage hands to identification.
+// A Point3 is one 3D *candidate*: it records, for every camera of the rig, which 2D
+// blob it was triangulated from (-1 when that camera is not used), so that the
+// identification stage knows which candidates are mutually exclusive (they share a
+// blob in some camera). Candidates whose blob is shared with another candidate are
+// flagged `ambiguous`; the stereo stage never silently picks one of them.
+// PointList is a fixed-capacity output buffer: capacity is set once at setup, the hot
+// path only clears and appends (push_back returns false when full, never allocates).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "core/types.h"
+
+namespace mocap {
+
+// Cameras a candidate can refer to (the rig's first kMaxCameras cameras).
+inline constexpr int kMaxCameras = 4;
+
+// Camera pairs for rigs with more than two cameras: one StereoTriangulator per pair.
+inline constexpr int kMaxCameraPairs = kMaxCameras * (kMaxCameras - 1) / 2;
+struct CameraPair {
+  int a = 0;
+  int b = 1;
+};
+// All pairs (a < b) of the first min(n_cameras, kMaxCameras) cameras in lexicographic
+// order ((0,1), (0,2), ..., (1,2), ...); returns how many were written.
+inline int enumerate_camera_pairs(int n_cameras,
+                                  std::array<CameraPair, kMaxCameraPairs>& pairs) noexcept {
+  const int n = n_cameras < kMaxCameras ? n_cameras : kMaxCameras;
+  int count = 0;
+  for (int a = 0; a < n; ++a)
+    for (int b = a + 1; b < n; ++b) pairs[static_cast<std::size_t>(count++)] = CameraPair{a, b};
+  return count;
+}
+
+struct Point3 {
+  Vec3 X_world = Vec3::Zero();  // mm, world frame
+  double reproj_px = 0.0;       // RMS reprojection error over the used views, real pixels
+  double epipolar_px = 0.0;     // max of the two symmetric epipolar distances (undistorted px)
+  std::array<std::int16_t, kMaxCameras> blob_index{-1, -1, -1, -1};  // -1: camera unused
+  bool ambiguous = false;  // shares a blob with another candidate of the same frame
+};
+
+class PointList {
+ public:
+  PointList() = default;
+  explicit PointList(int capacity) { set_capacity(capacity); }
+
+  // Setup only (allocates).
+  void set_capacity(int capacity) {
+    points_.assign(static_cast<std::size_t>(capacity > 0 ? capacity : 0), Point3{});
+    size_ = 0;
+  }
+
+  void clear() noexcept { size_ = 0; }
+  bool push_back(const Point3& p) noexcept {
+    if (size_ >= capacity()) return false;
+    points_[static_cast<std::size_t>(size_++)] = p;
+    return true;
+  }
+  int size() const noexcept { return size_; }
+  bool empty() const noexcept { return size_ == 0; }
+  int capacity() const noexcept { return static_cast<int>(points_.size()); }
+  Point3& operator[](int i) noexcept { return points_[static_cast<std::size_t>(i)]; }
+  const Point3& operator[](int i) const noexcept { return points_[static_cast<std::size_t>(i)]; }
+  Point3* begin() noexcept { return points_.data(); }
+  Point3* end() noexcept { return points_.data() + size_; }
+  const Point3* begin() const noexcept { return points_.data(); }
+  const Point3* end() const noexcept { return points_.data() + size_; }
+
+ private:
+  std::vector<Point3> points_;
+  int size_ = 0;
+};
+
+}  // namespace mocap
