@@ -39,12 +39,15 @@ function(mocap_add_test name)
   add_executable(${name} ${ARG_SOURCES})
   mocap_target_options(${name})
   target_link_libraries(${name} PRIVATE ${ARG_DEPS} GTest::gtest_main GTest::gmock)
+  # Where tests find the sources and the built `mocap` (environment variables override).
+  target_compile_definitions(${name} PRIVATE MOCAP_TEST_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
+                                             MOCAP_TEST_BINARY_DIR="${PROJECT_BINARY_DIR}")
   if("concurrency" IN_LIST ARG_LABELS)
     add_dependencies(mocap_concurrency_tests ${name})
   endif()
   add_dependencies(mocap_all_tests ${name})
   gtest_discover_tests(${name} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}
-    PROPERTIES LABELS "${ARG_LABELS}" ENVIRONMENT "MOCAP_SOURCE_DIR=${PROJECT_SOURCE_DIR};MOCAP_BINARY_DIR=${PROJECT_BINARY_DIR}"
+    PROPERTIES LABELS "${ARG_LABELS}"
     DISCOVERY_TIMEOUT 60)
 endfunction()
 

@@ -17,6 +17,7 @@ void register_simulate(CLI::App& app, int& exit_code) {
     std::string motion = "smooth";
     sim::SimOptions opt;
     std::uint64_t seed = 1;
+    bool noise_given = false;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
@@ -26,8 +27,13 @@ void register_simulate(CLI::App& app, int& exit_code) {
   cmd->add_option("--motion", args->motion,
                   "smooth | poses | move400 | viewpoints (default smooth)");
   cmd->add_option("--seed", args->seed, "Random seed of noise, drop-outs and strays (default 1)");
-  cmd->add_option("--noise", args->opt.noise_dn,
-                  "Read noise sigma in output DN (default 1.5 at 8 bits, scaled for 16 bits)");
+  cmd->add_option_function<double>(
+      "--noise",
+      [args](const double& v) {
+        args->opt.noise_dn = v;
+        args->noise_given = true;
+      },
+      "Read noise sigma in output DN (default 1.5 at 8 bits, scaled for 16 bits)");
   cmd->add_option("--blur", args->opt.blur_px,
                   "Optical blur (Gaussian PSF) sigma in px (default 0.5)");
   cmd->add_option("--stray", args->opt.stray, "Number of shiny spots causing glints (default 0)");
@@ -45,6 +51,10 @@ void register_simulate(CLI::App& app, int& exit_code) {
     auto motion = sim::parse_motion(args->motion);
     if (!motion) {
       exit_code = fail(motion.error().message);
+      return;
+    }
+    if (args->opt.noise_dn < 0.0 && args->noise_given) {
+      exit_code = fail("simulate: noise: must be >= 0");
       return;
     }
     args->opt.motion = *motion;

@@ -43,14 +43,23 @@ inline std::string read_file(const std::string& path) {
   return std::string(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
 }
 
+#ifndef MOCAP_TEST_SOURCE_DIR
+#define MOCAP_TEST_SOURCE_DIR "."
+#endif
+#ifndef MOCAP_TEST_BINARY_DIR
+#define MOCAP_TEST_BINARY_DIR "."
+#endif
+
+// The source tree ($MOCAP_SOURCE_DIR, else the configured one).
 inline std::string source_dir() {
   const char* s = std::getenv("MOCAP_SOURCE_DIR");
-  return s ? s : ".";
+  return s ? s : MOCAP_TEST_SOURCE_DIR;
 }
 
+// The built `mocap` ($MOCAP_BINARY_DIR/mocap, else the configured build tree's).
 inline std::string mocap_binary() {
   const char* b = std::getenv("MOCAP_BINARY_DIR");
-  return std::string(b ? b : ".") + "/mocap";
+  return std::string(b ? b : MOCAP_TEST_BINARY_DIR) + "/mocap";
 }
 
 struct RunResult {

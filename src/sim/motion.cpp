@@ -1,0 +1,197 @@
+// Design: closed-form motion plans (see motion.h). Angles in radians; the commanded
+// shoulder angles are R_cmd = Rx(q0) Ry(q1) Rz(q2) in torso axes (q0 < 0 raises the
+// arm towards the cameras, q1 < 0 lifts it sideways away from the torso, q2 turns it
+// about its own axis); the elbow angle bends the forearm towards the cameras.
+#include "sim/motion.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+
+#include "core/rotation.h"
+#include "sim/sim_rng.h"
+
+namespace mocap::sim {
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+constexpr double kTwoPi = 2.0 * std::numbers::pi;
+
+double halton(int index, int base) {
+  double f = 1.0, r = 0.0;
+  for (int i = index; i > 0; i /= base) {
+    f /= base;
+    r += f * (i % base);
+  }
+  return r;
+}
+
+// Joint angles of the static motions (move400, viewpoints).
+JointConfig fixed_pose() {
+  JointConfig c;
+  c.shoulder_rad = Vec3(-25.0, -25.0, 10.0) * kDeg;
+  c.elbow_rad = 60.0 * kDeg;
+  return c;
+}
+
+void plan_smooth(const MotionSpec& spec, MotionPlan& plan) {
+  const double duration_s = spec.frames / spec.fps;
+  // At least ~0.7..1.7 cycles over the recording, at most 1.5 Hz.
+  const std::array<double, 4> cycles = {0.9, 1.3, 0.7, 1.7};
+  const std::array<double, 4> base_hz = {0.11, 0.17, 0.13, 0.23};
+  std::array<double, 4> hz{};
+  for (std::size_t i = 0; i < 4; ++i)
+    hz[i] = std::min(1.5, std::max(base_hz[i], cycles[i] / duration_s));
+  for (int f = 0; f < spec.frames; ++f) {
+    const double t = f / spec.fps;
+    JointConfig c;
+    c.shoulder_rad = Vec3(-25.0 + 40.0 * std::sin(kTwoPi * hz[0] * t + 0.3),
+                          -28.0 + 26.0 * std::sin(kTwoPi * hz[1] * t + 1.1),
+                          35.0 * std::sin(kTwoPi * hz[2] * t + 2.0)) *
+                     kDeg;
+    c.elbow_rad = (60.0 + 50.0 * std::sin(kTwoPi * hz[3] * t - 0.5)) * kDeg;
+    plan.configs.push_back(c);
+  }
+  plan.segments.push_back(MotionSegment{"move", 0, spec.frames - 1, Vec3::Zero()});
+}
+
+void plan_poses(const MotionSpec& spec, MotionPlan& plan) {
+  std::vector<JointConfig> poses;
+  Rng rng(hash_mix(spec.seed, 0x706F736573ull));
+  for (int k = 0; k < spec.poses; ++k) {
+    JointConfig c;
+    const double j0 = rng.uniform(-3.0, 3.0), j1 = rng.uniform(-3.0, 3.0);
+    const double j2 = rng.uniform(-3.0, 3.0), j3 = rng.uniform(-3.0, 3.0);
+    c.shoulder_rad =
+        Vec3(-70.0 + 85.0 * halton(k + 1, 2) + j0, -58.0 + 60.0 * halton(k + 1, 3) + j1,
+             -40.0 + 80.0 * halton(k + 1, 5) + j2) *
+        kDeg;
+    c.elbow_rad = (8.0 + 105.0 * halton(k + 1, 7) + j3) * kDeg;
+    poses.push_back(c);
+  }
+  for (int f = 0; f < spec.frames; ++f) {
+    plan.configs.push_back(
+        poses[static_cast<std::size_t>(static_cast<std::int64_t>(f) * spec.poses / spec.frames)]);
+  }
+  int first = 0;
+  for (int f = 1; f <= spec.frames; ++f) {
+    const auto k_prev = static_cast<std::int64_t>(f - 1) * spec.poses / spec.frames;
+    const auto k_cur = static_cast<std::int64_t>(f) * spec.poses / spec.frames;
+    if (f == spec.frames || k_cur != k_prev) {
+      plan.segments.push_back(MotionSegment{"hold", first, f - 1, Vec3::Zero()});
+      first = f;
+    }
+  }
+}
+
+void plan_move400(const MotionSpec& spec, MotionPlan& plan) {
+  const std::array<Vec3, 4> dirs = {Vec3(0.0, 1.0, 0.0), Vec3(0.4, 0.917, 0.0),
+                                    Vec3(-0.4, 0.917, 0.0), Vec3(0.3, 0.8, 0.35)};
+  const int n_moves = static_cast<int>(dirs.size());
+  for (int m = 0; m < n_moves; ++m) {
+    const int first = spec.frames * m / n_moves;
+    const int last = spec.frames * (m + 1) / n_moves - 1;
+    const int n = last - first + 1;
+    const int hold = std::max(1, n / 4);
+    const Vec3 d = dirs[static_cast<std::size_t>(m)].normalized();
+    // From 150 mm nearer to 250 mm farther than the reference: 400 mm, all in view.
+    const Vec3 start = -150.0 * d, end = 250.0 * d;
+    const int move_first = first + hold, move_last = last - hold;  // frames strictly moving
+    for (int f = first; f <= last; ++f) {
+      double x = 0.0;
+      if (f >= move_last + 1) {
+        x = 1.0;
+      } else if (f >= move_first) {
+        x = (f - move_first + 1.0) / (move_last - move_first + 2.0);
+      }
+      const double s = x * x * (3.0 - 2.0 * x);
+      JointConfig c = fixed_pose();
+      c.T_world_robot = make_iso(Mat3::Identity(), start + s * (end - start));
+      plan.configs.push_back(c);
+    }
+    plan.segments.push_back(MotionSegment{"hold", first, move_first - 1, start});
+    if (move_last >= move_first)
+      plan.segments.push_back(MotionSegment{"move", move_first, move_last, Vec3::Zero()});
+    plan.segments.push_back(MotionSegment{"hold", move_last + 1, last, end});
+  }
+}
+
+void plan_viewpoints(const SimScene& scene, const MotionSpec& spec, MotionPlan& plan) {
+  const Vec3 c = scene.robot_center_world;
+  for (int f = 0; f < spec.frames; ++f) {
+    const double x = spec.frames > 1 ? static_cast<double>(f) / (spec.frames - 1) : 0.0;
+    const double yaw = 55.0 * std::sin(kTwoPi * 1.0 * x) * kDeg;
+    const double pitch = 20.0 * std::sin(kTwoPi * 0.7 * x + 0.8) * kDeg;
+    const double roll = 10.0 * std::sin(kTwoPi * 1.3 * x + 2.1) * kDeg;
+    const Vec3 shift(60.0 * std::sin(kTwoPi * 0.5 * x), 120.0 * std::sin(kTwoPi * 0.9 * x + 1.0),
+                     40.0 * std::sin(kTwoPi * 1.1 * x));
+    const Mat3 R = rot_z(yaw) * rot_x(pitch) * rot_y(roll);
+    JointConfig cfg = fixed_pose();
+    cfg.T_world_robot = make_iso(R, c + shift - R * c);
+    plan.configs.push_back(cfg);
+  }
+  plan.segments.push_back(MotionSegment{"move", 0, spec.frames - 1, Vec3::Zero()});
+}
+
+}  // namespace
+
+const char* motion_name(MotionKind kind) noexcept {
+  switch (kind) {
+    case MotionKind::kSmooth:
+      return "smooth";
+    case MotionKind::kPoses:
+      return "poses";
+    case MotionKind::kMove400:
+      return "move400";
+    case MotionKind::kViewpoints:
+      return "viewpoints";
+  }
+  return "smooth";
+}
+
+Expected<MotionKind> parse_motion(const std::string& name) {
+  for (MotionKind k :
+       {MotionKind::kSmooth, MotionKind::kPoses, MotionKind::kMove400, MotionKind::kViewpoints}) {
+    if (name == motion_name(k)) return k;
+  }
+  return make_error("simulate", "motion",
+                    "unknown motion '" + name + "' (smooth|poses|move400|viewpoints)");
+}
+
+Expected<MotionPlan> plan_motion(const SimScene& scene, const MotionSpec& spec) {
+  if (spec.frames < 1 || spec.frames > 1000000)
+    return make_error("simulate", "frames", "must be 1..1000000");
+  if (!(spec.fps > 0.0 && spec.fps <= 100000.0))
+    return make_error("simulate", "fps", "must be in (0, 100000]");
+  MotionPlan plan;
+  plan.configs.reserve(static_cast<std::size_t>(spec.frames));
+  switch (spec.kind) {
+    case MotionKind::kSmooth:
+      plan_smooth(spec, plan);
+      break;
+    case MotionKind::kPoses:
+      if (spec.poses < 1) return make_error("simulate", "poses", "must be >= 1");
+      if (spec.frames < spec.poses)
+        return make_error(
+            "simulate", "frames",
+            "must be at least the number of poses (" + std::to_string(spec.poses) + ")");
+      plan_poses(spec, plan);
+      break;
+    case MotionKind::kMove400:
+      if (spec.frames < 12)
+        return make_error("simulate", "frames", "move400 needs at least 12 frames");
+      plan_move400(spec, plan);
+      break;
+    case MotionKind::kViewpoints:
+      plan_viewpoints(scene, spec, plan);
+      break;
+  }
+  return plan;
+}
+
+std::int64_t frame_timestamp_ns(std::int64_t frame, double fps) noexcept {
+  return static_cast<std::int64_t>(std::llround(static_cast<double>(frame) * 1e9 / fps));
+}
+
+}  // namespace mocap::sim

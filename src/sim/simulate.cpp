@@ -1,0 +1,264 @@
+// Design: the recording writer. Per frame: forward kinematics, one render per camera
+// (camera 1 on a second thread with its own workspace when threads = 2; results are
+// identical either way because every random draw is keyed by seed, frame and camera),
+// the PGM files, then the ground-truth rows. Files are written with mocap_formats.
+#include "sim/simulate.h"
+
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <thread>
+
+#include "core/rotation.h"
+#include "formats/csv_outputs.h"
+#include "formats/joints_yaml.h"
+#include "formats/pgm.h"
+#include "formats/recording.h"
+#include "formats/rig_yaml.h"
+#include "formats/targets_yaml.h"
+#include "sim/render.h"
+#include "sim/sim_rng.h"
+
+namespace mocap::sim {
+namespace {
+
+constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
+
+Expected<void> make_dir(const std::string& path) {
+  std::error_code ec;
+  std::filesystem::create_directories(path, ec);
+  if (ec || !std::filesystem::is_directory(path, ec)) {
+    return make_error(path, "",
+                      "cannot create directory" + (ec ? ": " + ec.message() : std::string()));
+  }
+  return {};
+}
+
+Quat hinge_zero(const JointSpec& joint) {
+  for (const auto& [key, values] : joint.extra) {
+    if (key == "zero_q_parent_child" && values.size() == 4) {
+      return Quat(values[0], values[1], values[2], values[3]).normalized();
+    }
+  }
+  return Quat::Identity();
+}
+
+struct CameraResult {
+  std::vector<MarkerView> markers;
+  std::vector<StrayView> strays;
+  bool ok = false;
+  Error error{};
+};
+
+void render_camera(const SimScene& scene, const SceneState& state, int cam, RenderWorkspace& ws,
+                   Image& img, const std::string& path, CameraResult& result) {
+  result.ok = render(scene, state, cam, ws, img);
+  if (!result.ok) {
+    result.error = make_error("simulate", "render", "camera " + std::to_string(cam) + " failed");
+    return;
+  }
+  result.markers.assign(ws.markers.begin(), ws.markers.end());
+  result.strays.assign(ws.strays.begin(), ws.strays.begin() + ws.stray_count);
+  auto w = write_pgm(path, img.view());
+  if (!w) {
+    result.ok = false;
+    result.error = w.error();
+  }
+}
+
+const char* stray_name(StrayKind k) { return k == StrayKind::kGlint ? "glint" : "streak"; }
+
+}  // namespace
+
+Vec3 joint_angles_rad(const JointSpec& joint, const Iso3& T_world_parent,
+                      const Iso3& T_world_child) {
+  const Mat3 R_rel = T_world_parent.linear().transpose() * T_world_child.linear();
+  if (joint.type == JointType::kBall) return rotation_to_euler_xyz(R_rel);
+  const Mat3 Rd = R_rel * hinge_zero(joint).toRotationMatrix().transpose();
+  const Vec3 v(Rd(2, 1) - Rd(1, 2), Rd(0, 2) - Rd(2, 0), Rd(1, 0) - Rd(0, 1));  // 2 sin(a) axis
+  const double angle =
+      std::atan2(0.5 * v.dot(joint.axis_parent.normalized()), 0.5 * (Rd.trace() - 1.0));
+  return Vec3(angle, 0.0, 0.0);
+}
+
+std::uint64_t frame_noise_key(std::uint64_t seed, std::int64_t frame) noexcept {
+  return hash_mix(hash_mix(seed, 0x6672616D65ull), static_cast<std::uint64_t>(frame));
+}
+
+Expected<SimScene> make_scene(const SimOptions& o) {
+  if (o.bits != 8 && o.bits != 16) return make_error("simulate", "bits", "must be 8 or 16");
+  int maxval = o.maxval;
+  if (maxval == 0) maxval = o.bits == 8 ? 255 : 4095;
+  if (o.bits == 8 && maxval != 255)
+    return make_error("simulate", "maxval", "must be 255 for 8-bit output");
+  if (o.bits == 16 && (maxval < 256 || maxval > 65535))
+    return make_error("simulate", "maxval", "must be 256..65535 for 16-bit output");
+  SceneOptions so;
+  so.seed = o.seed;
+  so.stray_glints = o.stray;
+  so.imaging = default_imaging(o.bits, maxval);
+  if (!(o.noise_dn < 0.0)) {
+    if (!std::isfinite(o.noise_dn)) return make_error("simulate", "noise", "must be finite");
+    so.imaging.read_noise_dn = o.noise_dn;
+  }
+  so.imaging.blur_sigma_px = o.blur_px;
+  so.imaging.dropout_probability = o.dropout;
+  so.imaging.streak = o.streak;
+  return build_shoulder_scene(so);
+}
+
+Expected<SimSummary> write_simulated_recording(const SimOptions& options, const std::string& dir,
+                                               const std::function<void(int)>& progress) {
+  const auto t_start = std::chrono::steady_clock::now();
+  auto scene_r = make_scene(options);
+  if (!scene_r) return scene_r.error();
+  const SimScene& scene = *scene_r;
+  MotionSpec spec;
+  spec.kind = options.motion;
+  spec.frames = options.frames;
+  spec.fps = options.fps;
+  spec.poses = options.poses;
+  spec.seed = options.seed;
+  auto plan_r = plan_motion(scene, spec);
+  if (!plan_r) return plan_r.error();
+  const MotionPlan& plan = *plan_r;
+
+  for (const std::string& d : {dir, dir + "/gt", dir + "/" + scene.rig.cameras[0].name,
+                               dir + "/" + scene.rig.cameras[1].name}) {
+    if (auto r = make_dir(d); !r) return r.error();
+  }
+  std::vector<FrameEntry> frames;
+  for (int f = 0; f < options.frames; ++f)
+    frames.push_back(FrameEntry{f, frame_timestamp_ns(f, options.fps)});
+  for (auto r :
+       {save_rig(dir + "/rig.yaml", scene.rig), save_frames_csv(dir + "/frames.csv", frames),
+        save_targets(dir + "/targets.yaml", scene.targets),
+        save_model(dir + "/joints.yaml", joint_topology(scene)),
+        save_model(dir + "/gt/model_true.yaml", scene.joints_true)}) {
+    if (!r) return r.error();
+  }
+
+  auto poses_csv = open_poses_csv(dir + "/gt/poses.csv");
+  if (!poses_csv) return poses_csv.error();
+  auto angles_csv = open_angles_csv(dir + "/gt/angles.csv");
+  if (!angles_csv) return angles_csv.error();
+  auto markers_csv = CsvFile::open(dir + "/gt/markers.csv",
+                                   "frame,body,marker,x,y,z,u0,v0,vis0,u1,v1,vis1,"
+                                   "frac0,merged0,dropped0,frac1,merged1,dropped1");
+  if (!markers_csv) return markers_csv.error();
+  auto strays_csv = CsvFile::open(dir + "/gt/strays.csv", "frame,camera,kind,x,y,z,u,v,peak_dn");
+  if (!strays_csv) return strays_csv.error();
+  auto segments_csv =
+      CsvFile::open(dir + "/gt/segments.csv", "segment,kind,first_frame,last_frame,tx,ty,tz");
+  if (!segments_csv) return segments_csv.error();
+  for (std::size_t i = 0; i < plan.segments.size(); ++i) {
+    const MotionSegment& s = plan.segments[i];
+    std::fprintf(segments_csv->handle(), "%zu,%s,%d,%d,%.6f,%.6f,%.6f\n", i, s.kind.c_str(),
+                 s.first_frame, s.last_frame, s.robot_translation_mm.x(),
+                 s.robot_translation_mm.y(), s.robot_translation_mm.z());
+  }
+
+  auto ws0 = RenderWorkspace::create(scene);
+  if (!ws0) return ws0.error();
+  RenderWorkspace ws1 = *ws0;  // copies the read-only lattices instead of recomputing them
+  std::array<RenderWorkspace*, 2> ws = {&*ws0, &ws1};
+  std::array<Image, 2> images = {make_camera_image(scene, 0), make_camera_image(scene, 1)};
+  std::array<CameraResult, 2> results;
+  SceneState state = make_state(scene);
+  SimSummary summary;
+  summary.frames = options.frames;
+  summary.cameras = 2;
+
+  for (int f = 0; f < options.frames; ++f) {
+    apply_config(scene, plan.configs[static_cast<std::size_t>(f)], state);
+    state.noise_key = frame_noise_key(options.seed, f);
+    auto job = [&](int c) {
+      render_camera(scene, state, c, *ws[static_cast<std::size_t>(c)],
+                    images[static_cast<std::size_t>(c)],
+                    frame_file_path(dir, scene.rig.cameras[static_cast<std::size_t>(c)].name, f),
+                    results[static_cast<std::size_t>(c)]);
+    };
+    if (options.threads >= 2) {
+      std::thread t1(job, 1);
+      job(0);
+      t1.join();
+    } else {
+      job(0);
+      job(1);
+    }
+    for (const CameraResult& r : results) {
+      if (!r.ok) return r.error;
+    }
+    const std::int64_t ts = frames[static_cast<std::size_t>(f)].timestamp_ns;
+    for (int b = 0; b < kBodyCount; ++b) {
+      const Iso3& T = state.T_world_body[static_cast<std::size_t>(b)];
+      PoseRow row;
+      row.frame = f;
+      row.timestamp_ns = ts;
+      row.body = scene.targets.bodies[static_cast<std::size_t>(b)].name;
+      row.q_world_body = canonical_quat(T.linear());
+      row.t_world_body = T.translation();
+      row.markers =
+          static_cast<int>(scene.targets.bodies[static_cast<std::size_t>(b)].markers_body.size());
+      row.rms_mm = 0.0;
+      write_row(*poses_csv, row);
+    }
+    for (const JointSpec& j : scene.joints_true.joints) {
+      const Iso3& Tp = state.T_world_body[static_cast<std::size_t>(j.parent_index)];
+      const Iso3& Tc = state.T_world_body[static_cast<std::size_t>(j.child_index)];
+      AngleRow row;
+      row.frame = f;
+      row.timestamp_ns = ts;
+      row.joint = j.name;
+      row.type = j.type;
+      row.angles_deg = joint_angles_rad(j, Tp, Tc) * kRadToDeg;
+      row.q_parent_child = canonical_quat(Tp.linear().transpose() * Tc.linear());
+      write_row(*angles_csv, row);
+    }
+    for (int m = 0; m < scene.marker_count(); ++m) {
+      const auto um = static_cast<std::size_t>(m);
+      const Vec3 X = state.T_world_body[static_cast<std::size_t>(scene.marker_body[um])] *
+                     scene.marker_in_body(m);
+      std::fprintf(
+          markers_csv->handle(), "%d,%s,%d,%.6f,%.6f,%.6f", f,
+          scene.targets.bodies[static_cast<std::size_t>(scene.marker_body[um])].name.c_str(),
+          scene.marker_index[um], X.x(), X.y(), X.z());
+      for (const CameraResult& r : results) {
+        const MarkerView& mv = r.markers[um];
+        std::fprintf(markers_csv->handle(), ",%.6f,%.6f,%d", mv.center_px.x(), mv.center_px.y(),
+                     mv.isolated() ? 1 : 0);
+        ++summary.marker_views;
+        summary.isolated_views += mv.isolated() ? 1 : 0;
+        summary.occluded_views += (mv.in_front && !mv.dropped && mv.occluded_area_px > 0.0) ? 1 : 0;
+        summary.dropped_views += mv.dropped ? 1 : 0;
+      }
+      for (const CameraResult& r : results) {
+        const MarkerView& mv = r.markers[um];
+        const double total = mv.visible_area_px + mv.occluded_area_px;
+        const double frac = (total > 0.0 && mv.inside_image) ? mv.visible_area_px / total : 0.0;
+        std::fprintf(markers_csv->handle(), ",%.4f,%d,%d", frac, mv.merged ? 1 : 0,
+                     mv.dropped ? 1 : 0);
+      }
+      std::fputc('\n', markers_csv->handle());
+    }
+    for (int c = 0; c < 2; ++c) {
+      for (const StrayView& s : results[static_cast<std::size_t>(c)].strays) {
+        std::fprintf(strays_csv->handle(), "%d,%d,%s,%.4f,%.4f,%.4f,%.4f,%.4f,%.2f\n", f, c,
+                     stray_name(s.kind), s.X_world.x(), s.X_world.y(), s.X_world.z(), s.px.x(),
+                     s.px.y(), s.peak_dn);
+        summary.stray_blobs += s.kind == StrayKind::kGlint ? 1 : 0;
+      }
+    }
+    if (progress) progress(f + 1);
+  }
+  for (CsvFile* csv : {&*poses_csv, &*angles_csv, &*markers_csv, &*strays_csv, &*segments_csv}) {
+    if (auto r = csv->close(); !r) return r.error();
+  }
+  summary.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+  return summary;
+}
+
+}  // namespace mocap::sim

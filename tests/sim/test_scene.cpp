@@ -1,0 +1,212 @@
+// Scene tests: the rig is the paper's, the targets are distinguishable (distinct
+// inter-marker distances, non-congruent targets), the true joint model is consistent
+// with the forward kinematics, the joint angles follow the documented conventions,
+// and the arm stays in both images over the motions.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+
+#include "core/rotation.h"
+#include "sim/motion.h"
+#include "sim/simulate.h"
+
+namespace mocap::sim {
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+SimScene default_scene() {
+  auto s = make_scene(SimOptions{});
+  EXPECT_TRUE(s.ok());
+  return *s;
+}
+
+TEST(SimScene, StereoRigLikeThePaper) {
+  const SimScene s = default_scene();
+  ASSERT_EQ(s.rig.cameras.size(), 2u);
+  const CameraModel& c0 = s.rig.cameras[0];
+  const CameraModel& c1 = s.rig.cameras[1];
+  EXPECT_EQ(c0.width, 1032);
+  EXPECT_EQ(c0.height, 776);
+  EXPECT_NEAR((c0.center_world() - c1.center_world()).norm(), 477.0, 0.5);
+  EXPECT_NEAR(c0.fx, 1290.0, 5.0);
+  const double dist = (s.robot_center_world - 0.5 * (c0.center_world() + c1.center_world())).norm();
+  EXPECT_GT(dist, 900.0);
+  EXPECT_LT(dist, 1150.0);
+  // Verged: the optical axes converge.
+  const Vec3 z0 = c0.R_cam_world.row(2).transpose(), z1 = c1.R_cam_world.row(2).transpose();
+  EXPECT_GT(std::acos(z0.dot(z1)) / kDeg, 10.0);
+  EXPECT_LT(std::acos(z0.dot(z1)) / kDeg, 40.0);
+}
+
+TEST(SimScene, TargetsHaveDistinctDistancesAndAreNotCongruent) {
+  const SimScene s = default_scene();
+  ASSERT_EQ(s.targets.bodies.size(), 3u);
+  std::vector<std::vector<double>> dists;
+  for (const MarkerTarget& t : s.targets.bodies) {
+    EXPECT_GE(t.markers_body.size(), 4u);
+    EXPECT_LE(t.markers_body.size(), 6u);
+    std::vector<double> d;
+    for (std::size_t i = 0; i < t.markers_body.size(); ++i)
+      for (std::size_t j = i + 1; j < t.markers_body.size(); ++j)
+        d.push_back((t.markers_body[i] - t.markers_body[j]).norm());
+    std::sort(d.begin(), d.end());
+    EXPECT_GT(d.front(), 20.0) << t.name;  // balls well apart
+    for (std::size_t k = 1; k < d.size(); ++k)
+      EXPECT_GT(d[k] - d[k - 1], 2.0) << t.name << " distance " << d[k];
+    dists.push_back(d);
+  }
+  // Non-congruent: no triangle of one target matches a triangle of another within 2 mm.
+  auto triangles = [&](const MarkerTarget& t) {
+    std::vector<std::array<double, 3>> out;
+    const auto& m = t.markers_body;
+    for (std::size_t i = 0; i < m.size(); ++i)
+      for (std::size_t j = i + 1; j < m.size(); ++j)
+        for (std::size_t k = j + 1; k < m.size(); ++k) {
+          std::array<double, 3> e = {(m[i] - m[j]).norm(), (m[j] - m[k]).norm(),
+                                     (m[i] - m[k]).norm()};
+          std::sort(e.begin(), e.end());
+          out.push_back(e);
+        }
+    return out;
+  };
+  for (std::size_t a = 0; a < 3; ++a)
+    for (std::size_t b = a + 1; b < 3; ++b)
+      for (const auto& ta : triangles(s.targets.bodies[a]))
+        for (const auto& tb : triangles(s.targets.bodies[b])) {
+          const double diff =
+              std::max({std::abs(ta[0] - tb[0]), std::abs(ta[1] - tb[1]), std::abs(ta[2] - tb[2])});
+          EXPECT_GT(diff, 2.0) << s.targets.bodies[a].name << " vs " << s.targets.bodies[b].name;
+        }
+}
+
+TEST(SimScene, TrueModelIsConsistentWithTheKinematics) {
+  const SimScene s = default_scene();
+  MotionSpec spec;
+  spec.frames = 60;
+  auto plan = plan_motion(s, spec);
+  ASSERT_TRUE(plan.ok());
+  SceneState st = make_state(s);
+  const JointSpec& sh = s.joints_true.joints[0];
+  const JointSpec& el = s.joints_true.joints[1];
+  for (const JointConfig& cfg : plan->configs) {
+    apply_config(s, cfg, st);
+    const auto& T = st.T_world_body;
+    EXPECT_LT((T[kTorso] * sh.center_parent - T[kUpperArm] * sh.center_child).norm(), 1e-9);
+    EXPECT_LT((T[kUpperArm] * el.center_parent - T[kLowerArm] * el.center_child).norm(), 1e-9);
+    EXPECT_LT(
+        (T[kUpperArm].linear() * el.axis_parent - T[kLowerArm].linear() * el.axis_child).norm(),
+        1e-12);
+    // Angles: hinge = the commanded elbow angle; ball = Euler XYZ of R_parent^T R_child.
+    EXPECT_NEAR(joint_angles_rad(el, T[kUpperArm], T[kLowerArm])[0], cfg.elbow_rad, 1e-9);
+    const Vec3 a = joint_angles_rad(sh, T[kTorso], T[kUpperArm]);
+    const Mat3 R_rel = T[kTorso].linear().transpose() * T[kUpperArm].linear();
+    EXPECT_LT((euler_xyz_to_rotation(a) - R_rel).norm(), 1e-9);
+  }
+}
+
+TEST(SimScene, HingeAngleSignFollowsTheRightHandRule) {
+  const SimScene s = default_scene();
+  SceneState st = make_state(s);
+  JointConfig cfg;
+  cfg.elbow_rad = 0.5;
+  apply_config(s, cfg, st);
+  // Forearm tip moves towards the cameras (-Y) for a positive angle about axis (-X).
+  const Vec3 tip_body = s.T_world_body_ref[kLowerArm].inverse() * Vec3(-60.0, 40.0, -235.0);
+  EXPECT_LT((st.T_world_body[kLowerArm] * tip_body).y(), 40.0 - 50.0);
+  EXPECT_NEAR(joint_angles_rad(s.joints_true.joints[1], st.T_world_body[kUpperArm],
+                               st.T_world_body[kLowerArm])[0],
+              0.5, 1e-12);
+}
+
+TEST(SimScene, ArmStaysInBothImages) {
+  const SimScene s = default_scene();
+  for (MotionKind kind :
+       {MotionKind::kSmooth, MotionKind::kPoses, MotionKind::kMove400, MotionKind::kViewpoints}) {
+    MotionSpec spec;
+    spec.kind = kind;
+    spec.frames = 220;
+    auto plan = plan_motion(s, spec);
+    ASSERT_TRUE(plan.ok());
+    SceneState st = make_state(s);
+    int inside = 0, total = 0;
+    for (const JointConfig& cfg : plan->configs) {
+      apply_config(s, cfg, st);
+      for (int m = 0; m < s.marker_count(); ++m) {
+        const Vec3 X =
+            st.T_world_body[static_cast<std::size_t>(s.marker_body[static_cast<std::size_t>(m)])] *
+            s.marker_in_body(m);
+        for (const CameraModel& cam : s.rig.cameras) {
+          Vec2 px;
+          ++total;
+          if (project(cam, X, px) && px.x() > 10 && px.y() > 10 && px.x() < cam.width - 11 &&
+              px.y() < cam.height - 11)
+            ++inside;
+        }
+      }
+    }
+    const double frac = static_cast<double>(inside) / total;
+    std::printf("motion %s: %.2f%% of marker projections inside both images\n", motion_name(kind),
+                100.0 * frac);
+    EXPECT_EQ(inside, total) << motion_name(kind);
+  }
+}
+
+TEST(SimMotion, Move400MovesExactly400mmBetweenHolds) {
+  const SimScene s = default_scene();
+  MotionSpec spec;
+  spec.kind = MotionKind::kMove400;
+  spec.frames = 200;
+  auto plan = plan_motion(s, spec);
+  ASSERT_TRUE(plan.ok());
+  int holds = 0;
+  for (std::size_t i = 0; i + 2 < plan->segments.size(); i += 3) {
+    const MotionSegment& a = plan->segments[i];
+    const MotionSegment& b = plan->segments[i + 2];
+    ASSERT_EQ(a.kind, "hold");
+    ASSERT_EQ(b.kind, "hold");
+    const Vec3 ta =
+        plan->configs[static_cast<std::size_t>(a.last_frame)].T_world_robot.translation();
+    const Vec3 tb =
+        plan->configs[static_cast<std::size_t>(b.first_frame)].T_world_robot.translation();
+    EXPECT_NEAR((tb - ta).norm(), 400.0, 1e-9);
+    EXPECT_EQ(plan->configs[static_cast<std::size_t>(a.first_frame)].T_world_robot.translation(),
+              ta);
+    ++holds;
+  }
+  EXPECT_EQ(holds, 4);
+}
+
+TEST(SimMotion, PosesAreDistinctAndHeld) {
+  const SimScene s = default_scene();
+  MotionSpec spec;
+  spec.kind = MotionKind::kPoses;
+  spec.frames = 110;
+  auto plan = plan_motion(s, spec);
+  ASSERT_TRUE(plan.ok());
+  ASSERT_EQ(plan->segments.size(), 22u);
+  for (std::size_t i = 0; i < plan->segments.size(); ++i) {
+    const MotionSegment& seg = plan->segments[i];
+    EXPECT_EQ(seg.last_frame - seg.first_frame + 1, 5);
+    for (std::size_t j = 0; j < i; ++j) {
+      const auto& a = plan->configs[static_cast<std::size_t>(seg.first_frame)];
+      const auto& b = plan->configs[static_cast<std::size_t>(plan->segments[j].first_frame)];
+      EXPECT_GT((a.shoulder_rad - b.shoulder_rad).norm() + std::abs(a.elbow_rad - b.elbow_rad),
+                5.0 * kDeg);
+    }
+  }
+  spec.frames = 10;
+  EXPECT_FALSE(plan_motion(s, spec).ok());
+}
+
+TEST(SimMotion, TimestampsFollowTheFrameRate) {
+  EXPECT_EQ(frame_timestamp_ns(0, 100.0), 0);
+  EXPECT_EQ(frame_timestamp_ns(3, 100.0), 30000000);
+  EXPECT_EQ(frame_timestamp_ns(1, 30.0), 33333333);
+}
+
+}  // namespace
+}  // namespace mocap::sim
