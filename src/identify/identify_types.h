@@ -1,0 +1,94 @@
+// Design: the value types of rigid-target identification (the paper's Eq. 1 search):
+// per-frame input points, the configuration validated at setup, the per-body output
+// and the failure counters. Everything here is fixed-capacity and trivially usable in
+// the hot path; capacities are compile-time bounds checked when the Identifier is
+// created (more markers, bodies or points than these are refused at setup or counted
+// as overflow per frame, never allocated for).
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "core/types.h"
+
+namespace mocap {
+
+inline constexpr int kMaxMarkers = 16;      // markers per target
+inline constexpr int kMaxBodies = 16;       // targets per Identifier
+inline constexpr int kMaxPoints = 256;      // measured 3D points per frame (hard bound)
+inline constexpr int kMaxBestPairs = 1024;  // bound of IdentifyConfig::best_pairs
+
+// One triangulated 3D point. blob_index[c] is the blob of camera c (0 or 1) it was
+// triangulated from, -1 if unknown. Two points sharing a blob in the same camera are
+// mutually exclusive (epipolar ambiguity): a solution uses at most one of them.
+struct MeasuredPoint {
+  Vec3 X_world = Vec3::Zero();  // mm
+  std::array<std::int16_t, 2> blob_index{{-1, -1}};
+};
+
+enum class MotionModel { kConstantPose, kConstantVelocity };
+enum class AmbiguityPolicy { kWarn, kReject };
+
+struct IdentifyConfig {
+  // --- the paper's search (Section 2.1, Eq. 1) ---
+  double t_mm = 5.0;        // threshold t: pair discrepancy and every residual < t
+  int best_pairs = 50;      // 2-matchings kept in the priority queue (the one heuristic)
+  double score_base = 1.5;  // penalty base: score = |r| * base^(k-m) / m
+  int min_markers = 3;      // m >= this (>= 3: Umeyama needs 3 points)
+  // Expected per-marker noise sigma_0: the score uses sqrt(|r|^2 + m*sigma_0^2) instead of
+  // |r|, so that a small subset cannot win merely because a 3-point fit absorbs 6 of its 9
+  // noise degrees of freedom (0 gives the paper's literal score; see identification.md).
+  double residual_floor_mm = 0.5;
+  int max_points = kMaxPoints;   // per-frame capacity (<= kMaxPoints); extra points dropped
+  int max_search_nodes = 20000;  // per target and frame; hitting it is counted
+  // A solution is accepted only if every solution that contradicts it (a point on another
+  // marker, a marker on another point) scores at least ambiguity_ratio times worse;
+  // otherwise the body is not reported in this frame (never a coin-flip identity).
+  // <= 1 disables the check.
+  double ambiguity_ratio = 1.5;
+  // --- temporal path ---
+  bool temporal = true;  // use the previous pose as a prior
+  MotionModel motion_model = MotionModel::kConstantVelocity;
+  double warm_gate_mm = 15.0;                   // nearest-neighbour gate around predicted markers
+  int warm_min_markers = 4;                     // fewer matched markers -> full search instead
+  double max_prior_age_s = 0.25;                // older prior -> full search
+  double max_speed_mm_per_s = 10000.0;          // <= 0 disables the check
+  double max_angular_speed_deg_per_s = 3600.0;  // <= 0 disables the check
+  // --- load time ---
+  AmbiguityPolicy ambiguity_policy = AmbiguityPolicy::kWarn;
+};
+
+struct BodyPose {
+  bool found = false;
+  bool from_prior = false;  // found by the temporal path (validated), not the full search
+  Iso3 T_world_body = Iso3::Identity();
+  int markers = 0;      // matched markers m
+  double rms_mm = 0.0;  // RMS residual of the least-squares fit over the m markers
+  double score = 0.0;   // Eq. 1 score of the solution
+  // Input index of the point matched to each model marker, -1 if unmatched.
+  std::array<std::int16_t, kMaxMarkers> point_index_of_marker{};
+};
+
+// One entry per target, in the order of TargetSet::bodies.
+struct BodyPoses {
+  int count = 0;  // number of targets
+  int found = 0;  // how many of them were found this frame
+  std::array<BodyPose, kMaxBodies> bodies{};
+};
+
+struct IdentifyCounters {
+  std::uint64_t frames = 0;
+  std::uint64_t bodies_found = 0;
+  std::uint64_t full_searches = 0;        // Eq. 1 searches run (including re-searches)
+  std::uint64_t warm_accepted = 0;        // bodies found by the temporal path
+  std::uint64_t warm_fallbacks = 0;       // prior present but validation failed -> search
+  std::uint64_t conflict_researches = 0;  // a body lost points to a better body: re-searched
+  std::uint64_t velocity_rejects = 0;     // pose jumped beyond the limits: dropped, re-acquire
+  std::uint64_t point_overflow = 0;       // points beyond max_points dropped (count of points)
+  std::uint64_t invalid_points = 0;       // non-finite points ignored
+  std::uint64_t node_limit_hits = 0;      // searches stopped at max_search_nodes
+  std::uint64_t bad_timestamps = 0;       // timestamp not increasing: prior dropped
+  std::uint64_t ambiguous_rejects = 0;    // best solution not clearly better than a rival
+};
+
+}  // namespace mocap

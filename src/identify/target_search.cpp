@@ -1,0 +1,245 @@
+// Design: see target_search.h for the algorithm. Implementation notes: the seed queue is
+// a std::push_heap/pop_heap max-heap over a preallocated array (worst kept on top), so
+// keeping the best N of M candidates costs O(M log N) without allocation; the extension
+// is a recursion of depth <= k - 2 over member state (slots of matched correspondences).
+#include "identify/target_search.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace mocap {
+namespace {
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr auto kSeedLess = [](const auto& x, const auto& y) { return x.disc_mm < y.disc_mm; };
+}  // namespace
+
+TargetSearch::TargetSearch(const IdentifyConfig& config)
+    : config_(config),
+      heap_(static_cast<std::size_t>(config.best_pairs)),
+      next_(static_cast<std::size_t>(config.best_pairs), -1),
+      src_(3, kMaxMarkers),
+      dst_(3, kMaxMarkers) {}
+
+void TargetSearch::push_seed(const Seed& s, SearchStats& stats) noexcept {
+  const auto cap = static_cast<int>(heap_.size());
+  if (heap_size_ < cap) {
+    heap_[static_cast<std::size_t>(heap_size_++)] = s;
+    std::push_heap(heap_.begin(), heap_.begin() + heap_size_, kSeedLess);
+    return;
+  }
+  ++stats.seeds_dropped;
+  if (!(s.disc_mm < heap_.front().disc_mm)) return;
+  std::pop_heap(heap_.begin(), heap_.begin() + heap_size_, kSeedLess);
+  heap_[static_cast<std::size_t>(heap_size_ - 1)] = s;
+  std::push_heap(heap_.begin(), heap_.begin() + heap_size_, kSeedLess);
+}
+
+void TargetSearch::collect_seeds(const TargetModel& model, const FramePoints& frame,
+                                 SearchStats& stats) noexcept {
+  heap_size_ = 0;
+  const double t = config_.t_mm;
+  const PointPair* pp = frame.pairs();
+  const int np = frame.pair_count();
+  int lo = 0;  // first measured pair with D > d - t (monotone: model pairs are sorted)
+  for (const ModelPair& mp : model.pairs_sorted) {
+    while (lo < np && pp[lo].d_mm <= mp.d_mm - t) ++lo;
+    for (int q = lo; q < np && pp[q].d_mm < mp.d_mm + t; ++q) {
+      const PointPair& p = pp[q];
+      if (!frame.available(p.i) || !frame.available(p.j)) continue;
+      const double disc = std::abs(p.d_mm - mp.d_mm);
+      push_seed(Seed{disc, p.i, p.j, mp.a, mp.b}, stats);
+      push_seed(Seed{disc, p.j, p.i, mp.a, mp.b}, stats);
+    }
+  }
+  std::sort_heap(heap_.begin(), heap_.begin() + heap_size_, kSeedLess);
+  stats.seeds = heap_size_;
+}
+
+double TargetSearch::score_of(int m, double sum_sq) const noexcept {
+  const double floor2 = config_.residual_floor_mm * config_.residual_floor_mm;
+  return std::sqrt(sum_sq + m * floor2) * model_->score_factor[static_cast<std::size_t>(m)];
+}
+
+double TargetSearch::lower_bound(int m_now, int m_max, double sum_sq) const noexcept {
+  double lb = kInf;
+  for (int m = std::max(m_now, config_.min_markers); m <= m_max; ++m)
+    lb = std::min(lb, score_of(m, sum_sq));
+  return lb;
+}
+
+bool TargetSearch::was_seed(int c, int p, int a, int q) const noexcept {
+  // Correspondences (c->p) and (a->q): was this pair an earlier, fully explored seed?
+  if (c > a) {
+    std::swap(c, a);
+    std::swap(p, q);
+  }
+  for (int s = head_[static_cast<std::size_t>(c)][static_cast<std::size_t>(a)]; s >= 0;
+       s = next_[static_cast<std::size_t>(s)]) {
+    const Seed& sd = heap_[static_cast<std::size_t>(s)];
+    // Stored seeds have a0 < a1 (model pairs are stored with a < b).
+    if (sd.p0 == p && sd.p1 == q) return true;
+  }
+  return false;
+}
+
+void TargetSearch::mark_seed(int seed_index) noexcept {
+  const Seed& sd = heap_[static_cast<std::size_t>(seed_index)];
+  auto& h = head_[static_cast<std::size_t>(sd.a0)][static_cast<std::size_t>(sd.a1)];
+  next_[static_cast<std::size_t>(seed_index)] = h;
+  h = static_cast<std::int16_t>(seed_index);
+}
+
+void TargetSearch::extend(int level, double sum_sq) noexcept {
+  if (limit_hit_) return;
+  if (++nodes_ > config_.max_search_nodes) {
+    limit_hit_ = true;
+    return;
+  }
+  if (level >= order_count_) return;
+  const int m_max = m_ + (order_count_ - level);
+  if (m_max < config_.min_markers) return;
+  if (rival_pass_) {
+    const double limit = std::min(config_.ambiguity_ratio * best_->score, best_->rival_score);
+    if (!(lower_bound(m_, m_max, sum_sq) < limit)) return;
+  } else if (best_->found && !(lower_bound(m_, m_max, sum_sq) < best_->score)) {
+    return;
+  }
+
+  const TargetModel& model = *model_;
+  FramePoints& frame = *frame_;
+  const double t = config_.t_mm;
+  const double t2 = t * t;
+  const int c = order_[static_cast<std::size_t>(level)];
+  const auto cs = static_cast<std::size_t>(c);
+  const Vec3& X0 = frame.X(slot_point_[0]);
+  const double d0 = model.dist_mm[cs][static_cast<std::size_t>(slot_marker_[0])];
+  const double lo2 = d0 > t ? (d0 - t) * (d0 - t) : 0.0;
+  const double hi2 = (d0 + t) * (d0 + t);
+  const int n = frame.size();
+  for (int p = 0; p < n; ++p) {
+    const double q2 = (frame.X(p) - X0).squaredNorm();
+    if (q2 <= lo2 || q2 >= hi2 || !frame.available(p)) continue;
+    bool ok = true;
+    for (int s = 1; s < m_ && ok; ++s) {
+      const double d = (frame.X(p) - frame.X(slot_point_[static_cast<std::size_t>(s)])).norm();
+      ok = std::abs(d - model.dist_mm[cs][static_cast<std::size_t>(
+                            slot_marker_[static_cast<std::size_t>(s)])]) < t;
+    }
+    for (int s = 0; s < m_ && ok; ++s)
+      ok = !was_seed(c, p, slot_marker_[static_cast<std::size_t>(s)],
+                     slot_point_[static_cast<std::size_t>(s)]);
+    if (!ok) continue;
+    // Take the correspondence c -> p.
+    const auto ms = static_cast<std::size_t>(m_);
+    slot_marker_[ms] = static_cast<std::int8_t>(c);
+    slot_point_[ms] = static_cast<std::int16_t>(p);
+    src_.col(m_) = model.M_body[cs];
+    dst_.col(m_) = frame.X(p);
+    ++m_;
+    const RigidFit fit = fit_rigid(src_, dst_, m_);
+    if (fit.max_sq_mm2 < t2) {
+      if (m_ >= config_.min_markers) record(score_of(m_, fit.sum_sq_mm2), fit);
+      frame.acquire(p);
+      extend(level + 1, fit.sum_sq_mm2);
+      frame.release(p);
+    }
+    --m_;
+    if (limit_hit_) return;
+  }
+  // Leave marker c unmatched.
+  extend(level + 1, sum_sq);
+}
+
+void TargetSearch::record(double score, const RigidFit& fit) noexcept {
+  SearchResult& b = *best_;
+  if (rival_pass_) {
+    if (score < b.rival_score && contradicts_best()) {
+      b.rival_score = score;
+      b.rival_point_of_marker.fill(-1);
+      for (int s = 0; s < m_; ++s)
+        b.rival_point_of_marker[static_cast<std::size_t>(
+            slot_marker_[static_cast<std::size_t>(s)])] = slot_point_[static_cast<std::size_t>(s)];
+    }
+    return;
+  }
+  if (b.found && !(score < b.score || (score == b.score && m_ > b.m))) return;
+  b.found = true;
+  b.m = m_;
+  b.score = score;
+  b.sum_sq_mm2 = fit.sum_sq_mm2;
+  b.T_world_body = fit.T_dst_src;
+  b.point_of_marker.fill(-1);
+  for (int s = 0; s < m_; ++s)
+    b.point_of_marker[static_cast<std::size_t>(slot_marker_[static_cast<std::size_t>(s)])] =
+        slot_point_[static_cast<std::size_t>(s)];
+}
+
+// The current node contradicts the best solution unless one of the two is a subset of
+// the other (a subset or a superset tells the same identities).
+bool TargetSearch::contradicts_best() const noexcept {
+  const auto& best = best_->point_of_marker;
+  int shared = 0;
+  for (int s = 0; s < m_; ++s) {
+    const int c = slot_marker_[static_cast<std::size_t>(s)];
+    if (best[static_cast<std::size_t>(c)] == slot_point_[static_cast<std::size_t>(s)]) ++shared;
+  }
+  return shared < m_ && shared < best_->m;
+}
+
+void TargetSearch::run_pass() noexcept {
+  const TargetModel& model = *model_;
+  FramePoints& frame = *frame_;
+  for (auto& row : head_) row.fill(-1);
+  for (int s = 0; s < heap_size_ && !limit_hit_; ++s) {
+    const Seed& sd = heap_[static_cast<std::size_t>(s)];
+    m_ = 2;
+    slot_marker_[0] = sd.a0;
+    slot_point_[0] = sd.p0;
+    slot_marker_[1] = sd.a1;
+    slot_point_[1] = sd.p1;
+    src_.col(0) = model.M_body[static_cast<std::size_t>(sd.a0)];
+    dst_.col(0) = frame.X(sd.p0);
+    src_.col(1) = model.M_body[static_cast<std::size_t>(sd.a1)];
+    dst_.col(1) = frame.X(sd.p1);
+    order_count_ = 0;
+    for (int a = 0; a < model.k; ++a) {
+      if (a != sd.a0 && a != sd.a1)
+        order_[static_cast<std::size_t>(order_count_++)] = static_cast<std::int8_t>(a);
+    }
+    frame.acquire(sd.p0);
+    frame.acquire(sd.p1);
+    // Two-point least squares: each point is off by half the discrepancy.
+    extend(0, 0.5 * sd.disc_mm * sd.disc_mm);
+    frame.release(sd.p1);
+    frame.release(sd.p0);
+    mark_seed(s);
+  }
+}
+
+bool TargetSearch::run(const TargetModel& model, FramePoints& frame, SearchResult& out,
+                       SearchStats& stats) noexcept {
+  out = SearchResult{};
+  out.point_of_marker.fill(-1);
+  stats = SearchStats{};
+  model_ = &model;
+  frame_ = &frame;
+  best_ = &out;
+  nodes_ = 0;
+  limit_hit_ = false;
+  collect_seeds(model, frame, stats);
+  rival_pass_ = false;
+  run_pass();
+  out.rival_score = std::numeric_limits<double>::infinity();
+  out.rival_point_of_marker.fill(-1);
+  if (out.found && config_.ambiguity_ratio > 1.0) {
+    rival_pass_ = true;
+    run_pass();
+  }
+  stats.nodes = nodes_;
+  stats.node_limit_hit = limit_hit_;
+  if (out.found) out.rms_mm = std::sqrt(out.sum_sq_mm2 / out.m);
+  return out.found;
+}
+
+}  // namespace mocap

@@ -1,0 +1,146 @@
+// Design: tests of the temporal path: same identities as the full search on smooth
+// motion, fallback on a wrong prior (swapped bodies), rejection of jumps beyond the speed
+// limits and re-acquisition on the next frame.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "identify/identifier.h"
+#include "tests/identify/identify_test_util.h"
+
+namespace mocap {
+namespace {
+
+using test::make_scene;
+using test::random_target;
+using test::SceneOptions;
+
+TargetSet three_bodies(std::mt19937_64& rng) {
+  for (;;) {
+    TargetSet set;
+    for (int b = 0; b < 3; ++b)
+      set.bodies.push_back(random_target(rng, 5, "b" + std::to_string(b)));
+    auto id = Identifier::create(set, IdentifyConfig{});
+    if (id.ok() && id->warnings().empty()) return set;
+  }
+}
+
+Iso3 moving_pose(int body, int frame) {
+  const double s = frame * 0.01;  // 100 fps
+  Iso3 T = Iso3::Identity();
+  T.linear() = (Eigen::AngleAxisd(0.8 * s + body, Vec3::UnitZ()) *
+                Eigen::AngleAxisd(0.5 * std::sin(2.0 * s + body), Vec3::UnitX()))
+                   .toRotationMatrix();
+  T.translation() =
+      Vec3(300.0 * body + 100.0 * std::sin(1.3 * s), 80.0 * std::cos(s), 2000.0 + 50.0 * s);
+  return T;
+}
+
+TEST(Temporal, SameIdentitiesAsFullSearch) {
+  std::mt19937_64 rng(51);
+  const TargetSet set = three_bodies(rng);
+  IdentifyConfig warm_cfg, cold_cfg;
+  cold_cfg.temporal = false;
+  auto warm = Identifier::create(set, warm_cfg);
+  auto cold = Identifier::create(set, cold_cfg);
+  ASSERT_TRUE(warm.ok() && cold.ok());
+  for (auto model : {MotionModel::kConstantVelocity, MotionModel::kConstantPose}) {
+    warm_cfg.motion_model = model;
+    warm = Identifier::create(set, warm_cfg);
+    for (int f = 0; f < test::scaled_trials(500); ++f) {
+      std::vector<Iso3> poses;
+      for (int b = 0; b < 3; ++b) poses.push_back(moving_pose(b, f));
+      SceneOptions opt;
+      opt.noise_mm = 0.2;
+      opt.strays = 10;
+      opt.occlude = (f % 7 == 3);
+      const auto scene = make_scene(rng, set, opt, &poses);
+      BodyPoses a, b;
+      const std::int64_t t_ns = f * 10'000'000LL;
+      warm->identify(scene.pts.data(), static_cast<int>(scene.pts.size()), t_ns, a);
+      cold->identify(scene.pts.data(), static_cast<int>(scene.pts.size()), t_ns, b);
+      for (int i = 0; i < 3; ++i) {
+        const auto& pa = a.bodies[static_cast<std::size_t>(i)];
+        const auto& pb = b.bodies[static_cast<std::size_t>(i)];
+        ASSERT_EQ(pa.found, pb.found) << "frame " << f;
+        EXPECT_EQ(pa.point_index_of_marker, pb.point_index_of_marker) << "frame " << f;
+        EXPECT_TRUE(test::identity_correct(scene, i, pa));
+        if (pa.found) {
+          EXPECT_TRUE(pa.T_world_body.isApprox(pb.T_world_body, 1e-9));
+        }
+      }
+    }
+    const auto& c = warm->counters();
+    EXPECT_GT(c.warm_accepted, c.frames * 2);  // most bodies by the temporal path
+    EXPECT_EQ(c.velocity_rejects, 0u);
+  }
+}
+
+// Frame 1: bodies at their places; frame 2: the two bodies swap places (the prior of each
+// lands on the other's points). No wrong identity, with and without speed limits.
+TEST(Temporal, SwappedBodiesNeverGiveWrongIdentity) {
+  std::mt19937_64 rng(61);
+  const TargetSet set = three_bodies(rng);
+  for (bool limits : {true, false}) {
+    IdentifyConfig cfg;
+    if (!limits) cfg.max_speed_mm_per_s = cfg.max_angular_speed_deg_per_s = 0.0;
+    auto id = Identifier::create(set, cfg);
+    ASSERT_TRUE(id.ok());
+    std::vector<Iso3> poses{moving_pose(0, 0), moving_pose(1, 0), moving_pose(2, 0)};
+    for (int f = 0; f < 6; ++f) {
+      if (f == 3) std::swap(poses[0], poses[1]);
+      SceneOptions opt;
+      opt.noise_mm = 0.2;
+      opt.strays = 10;
+      const auto scene = make_scene(rng, set, opt, &poses);
+      BodyPoses out;
+      id->identify(scene.pts.data(), static_cast<int>(scene.pts.size()), f * 10'000'000LL, out);
+      for (int b = 0; b < 3; ++b) {
+        const auto& p = out.bodies[static_cast<std::size_t>(b)];
+        EXPECT_TRUE(test::identity_correct(scene, b, p)) << "frame " << f << " body " << b;
+        if (f != 3 || !limits || b == 2) {
+          EXPECT_TRUE(p.found) << "frame " << f << " body " << b;
+        }
+      }
+      if (f == 3 && limits) {  // the swapped bodies jumped 300 mm in 10 ms: rejected
+        EXPECT_FALSE(out.bodies[0].found);
+        EXPECT_FALSE(out.bodies[1].found);
+      }
+    }
+    EXPECT_GE(id->counters().warm_fallbacks, 2u);
+    EXPECT_EQ(id->counters().velocity_rejects, limits ? 2u : 0u);
+  }
+}
+
+// A jump of one body: rejected once (counted), re-acquired by a full search next frame.
+TEST(Temporal, JumpRejectedThenReacquired) {
+  std::mt19937_64 rng(71);
+  const TargetSet set = three_bodies(rng);
+  IdentifyConfig cfg;
+  cfg.max_speed_mm_per_s = 2000.0;
+  auto id = Identifier::create(set, cfg);
+  ASSERT_TRUE(id.ok());
+  std::vector<Iso3> poses{moving_pose(0, 0), moving_pose(1, 0), moving_pose(2, 0)};
+  bool found[5];
+  for (int f = 0; f < 5; ++f) {
+    if (f == 2) poses[2].translation() += Vec3(0.0, 300.0, 0.0);  // 30 m/s for one frame
+    const auto scene = make_scene(rng, set, SceneOptions{0.1, 5, false, 3, 300.0}, &poses);
+    BodyPoses out;
+    id->identify(scene.pts.data(), static_cast<int>(scene.pts.size()), f * 10'000'000LL, out);
+    found[f] = out.bodies[2].found;
+    EXPECT_TRUE(test::identity_correct(scene, 2, out.bodies[2]));
+    EXPECT_TRUE(out.bodies[0].found && out.bodies[1].found);
+  }
+  EXPECT_TRUE(found[0] && found[1]);
+  EXPECT_FALSE(found[2]);
+  EXPECT_TRUE(found[3] && found[4]);
+  EXPECT_EQ(id->counters().velocity_rejects, 1u);
+  // A timestamp going backwards drops the priors (counted), identification goes on.
+  const auto scene = make_scene(rng, set, SceneOptions{0.1, 5, false, 3, 300.0}, &poses);
+  BodyPoses out;
+  EXPECT_TRUE(id->identify(scene.pts.data(), static_cast<int>(scene.pts.size()), 0, out));
+  EXPECT_EQ(id->counters().bad_timestamps, 1u);
+}
+
+}  // namespace
+}  // namespace mocap
