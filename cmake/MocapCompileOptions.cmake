@@ -46,9 +46,11 @@ function(mocap_add_test name)
     add_dependencies(mocap_concurrency_tests ${name})
   endif()
   add_dependencies(mocap_all_tests ${name})
-  gtest_discover_tests(${name} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}
-    PROPERTIES LABELS "${ARG_LABELS}"
-    DISCOVERY_TIMEOUT 60)
+  set(_props)
+  if(ARG_LABELS)
+    set(_props PROPERTIES LABELS "${ARG_LABELS}")
+  endif()
+  gtest_discover_tests(${name} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR} ${_props} DISCOVERY_TIMEOUT 60)
 endfunction()
 
 # mocap_add_bench(<name> SOURCES <files...> DEPS <targets...>)

@@ -14,21 +14,21 @@ inline constexpr std::uint16_t kMaxJoints = 32;
 enum class JointKind : std::uint8_t { kBall = 0, kHinge = 1 };
 
 struct JointRecord {
-  std::uint16_t index = 0;  // position of the joint in model.yaml
-  std::uint8_t type = 0;    // JointKind
-  std::uint8_t valid = 0;   // 1 when both bodies were found in this frame
-  float a[3] = {0.0f, 0.0f, 0.0f};  // radians: hinge (angle, 0, 0); ball XYZ Euler angles
+  std::uint16_t index = 0;                // position of the joint in model.yaml
+  std::uint8_t type = 0;                  // JointKind
+  std::uint8_t valid = 0;                 // 1 when both bodies were found in this frame
+  float a[3] = {0.0f, 0.0f, 0.0f};        // radians: hinge (angle, 0, 0); ball XYZ Euler angles
   float q[4] = {1.0f, 0.0f, 0.0f, 0.0f};  // qw, qx, qy, qz of R_parent^T R_child, qw >= 0
 };
 
 inline constexpr std::uint32_t kFlagAllBodiesFound = 1u << 0;
 
 struct JointsMessage {
-  std::uint64_t sequence = 0;       // counts every triggered frame: a gap means drops
-  std::int64_t capture_ns = 0;      // CLOCK_MONOTONIC, trigger of this frame
-  std::int64_t publish_ns = 0;      // CLOCK_MONOTONIC, when published
-  std::uint32_t flags = 0;          // kFlagAllBodiesFound
-  std::uint16_t joint_count = 0;    // records used in `joints`
+  std::uint64_t sequence = 0;     // counts every triggered frame: a gap means drops
+  std::int64_t capture_ns = 0;    // CLOCK_MONOTONIC, trigger of this frame
+  std::int64_t publish_ns = 0;    // CLOCK_MONOTONIC, when published
+  std::uint32_t flags = 0;        // kFlagAllBodiesFound
+  std::uint16_t joint_count = 0;  // records used in `joints`
   std::uint16_t reserved = 0;
   JointRecord joints[kMaxJoints];
 };

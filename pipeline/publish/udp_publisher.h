@@ -1,0 +1,56 @@
+// Design: tracker side of the UDP transport. create() resolves every "HOST:PORT"
+// destination once and opens ONE non-blocking IPv4 socket (never bound to a listening
+// port: the tracker sends only). publish() encodes datagram v1 into a preallocated
+// buffer and sendto()s each destination with MSG_DONTWAIT: noexcept, allocation-free,
+// no logging; transient errors (EAGAIN/ENOBUFS/ECONNREFUSED, ...) are only counted.
+#pragma once
+
+#include <netinet/in.h>
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "client/datagram.h"
+#include "client/joints_message.h"
+#include "core/expected.h"
+
+namespace mocap::publish {
+
+struct UdpPublisherCounters {
+  std::uint64_t messages = 0;         // publish() calls
+  std::uint64_t datagrams_sent = 0;   // successful sendto()s (messages x destinations)
+  std::uint64_t encode_failures = 0;  // joint_count > kMaxJoints
+  std::uint64_t would_block = 0;      // EAGAIN/EWOULDBLOCK/ENOBUFS: socket buffer full
+  std::uint64_t refused = 0;          // ECONNREFUSED (ICMP port unreachable reported)
+  std::uint64_t other_errors = 0;     // any other errno
+};
+
+class UdpPublisher {
+ public:
+  // Fails with one line, e.g. "udp publisher: 'host:99999': port must be 0..65535".
+  static Expected<UdpPublisher> create(const std::vector<std::string>& destinations);
+
+  UdpPublisher(UdpPublisher&& other) noexcept;
+  UdpPublisher& operator=(UdpPublisher&& other) noexcept;
+  UdpPublisher(const UdpPublisher&) = delete;
+  UdpPublisher& operator=(const UdpPublisher&) = delete;
+  ~UdpPublisher();
+
+  // True when the datagram went to every destination.
+  bool publish(const client::JointsMessage& msg) noexcept;
+
+  std::size_t destination_count() const noexcept { return destinations_.size(); }
+  const UdpPublisherCounters& counters() const noexcept { return counters_; }
+
+ private:
+  UdpPublisher(int fd, std::vector<sockaddr_in> destinations) noexcept;
+
+  int fd_ = -1;
+  std::vector<sockaddr_in> destinations_;  // fixed after create()
+  UdpPublisherCounters counters_{};
+  std::array<std::uint8_t, client::kMaxDatagramBytes> buf_{};
+};
+
+}  // namespace mocap::publish
