@@ -26,9 +26,18 @@
 namespace mocap {
 
 struct TrackerConfig {
-  detect::DetectorConfig detect{};
+  detect::DetectorConfig detect{[] {
+    detect::DetectorConfig c;
+    c.max_elongation = 1.3;
+    return c;
+  }()};
   StereoConfig stereo{};
-  IdentifyConfig identify{};
+  IdentifyConfig identify{[] {
+    IdentifyConfig c;
+    c.max_speed_mm_per_s = 3000.0;
+    c.max_angular_speed_deg_per_s = 1440.0;
+    return c;
+  }()};
 };
 
 // Wall-clock duration of each stage of one frame (ns). `detect` covers both cameras.
