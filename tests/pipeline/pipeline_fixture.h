@@ -1,0 +1,97 @@
+// Shared set-up of the pipeline tests: one short pre-rendered sim loop (process-wide),
+// a simulated stereo pair on it, a FrameProcessor with the scene's true model, and a
+// recording sink that stores messages in preallocated memory (allocation-free).
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <memory>
+#include <thread>
+#include <vector>
+
+#include "hal/sim_camera.h"
+#include "pipeline/pipeline.h"
+
+namespace mocap::pipeline::test {
+
+inline std::shared_ptr<const hal::SimFrameLoop> shared_loop() {
+  static std::shared_ptr<const hal::SimFrameLoop> loop = [] {
+    sim::SimOptions o;
+    o.frames = 30;
+    auto l = hal::SimFrameLoop::render(o);
+    EXPECT_TRUE(l.ok()) << (l.ok() ? "" : l.error().message);
+    return l.ok() ? *l : nullptr;
+  }();
+  return loop;
+}
+
+struct SimRigFixture {
+  std::shared_ptr<hal::SimTrigger> trigger;
+  std::unique_ptr<hal::SimCamera> cams[2];
+
+  explicit SimRigFixture(int buffers = 6) {
+    trigger = std::make_shared<hal::SimTrigger>(shared_loop());
+    for (int c = 0; c < 2; ++c) {
+      auto cam = hal::SimCamera::open(trigger, c);
+      EXPECT_TRUE(cam.ok());
+      cams[c] = std::move(cam).value();
+      hal::CameraConfig cfg = cams[c]->native_config();
+      cfg.buffer_count = buffers;
+      EXPECT_TRUE(cams[c]->configure(cfg).ok());
+    }
+  }
+  std::array<hal::Camera*, 2> cameras() { return {cams[0].get(), cams[1].get()}; }
+  FrameProcessor processor() const {
+    const sim::SimScene& sc = shared_loop()->scene();
+    auto p = FrameProcessor::create(sc.rig, sc.targets, &sc.joints_true, TrackerConfig{});
+    EXPECT_TRUE(p.ok()) << (p.ok() ? "" : p.error().message);
+    return std::move(p).value();
+  }
+};
+
+// Stores up to `capacity` messages; optional sleep per publish (a slow transport).
+class RecordingSink final : public JointsSink {
+ public:
+  explicit RecordingSink(std::size_t capacity, int sleep_us = 0)
+      : messages_(capacity), sleep_us_(sleep_us) {}
+  bool publish(const client::JointsMessage& m) noexcept override {
+    if (sleep_us_ > 0) std::this_thread::sleep_for(std::chrono::microseconds(sleep_us_));
+    const std::size_t n = count_.load(std::memory_order_relaxed);  // single writer
+    if (n >= messages_.size()) return false;
+    messages_[n] = m;
+    count_.store(n + 1, std::memory_order_release);  // publishes messages_[n]
+    return true;
+  }
+  std::size_t count() const noexcept { return count_.load(std::memory_order_acquire); }
+  const client::JointsMessage& operator[](std::size_t i) const { return messages_[i]; }
+
+ private:
+  std::vector<client::JointsMessage> messages_;
+  std::atomic<std::size_t> count_{0};
+  int sleep_us_ = 0;
+};
+
+inline PipelineOptions test_options() {
+  PipelineOptions o;
+  o.realtime = false;  // be polite on a shared test machine (no SCHED_FIFO, no pinning)
+  o.lock_memory = false;
+  return o;
+}
+
+// Waits (bounded) until the pipeline has handled every triggered frame.
+inline void wait_finished(const Pipeline& p, double max_seconds = 30.0) {
+  const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(max_seconds);
+  while (!p.finished() && std::chrono::steady_clock::now() < until)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+}
+
+inline std::uint64_t counter(const PipelineStats& s, const std::string& name) {
+  for (const auto& [n, v] : s.counters)
+    if (n == name) return v;
+  ADD_FAILURE() << "no counter " << name;
+  return 0;
+}
+
+}  // namespace mocap::pipeline::test
