@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Installs the dependencies, builds `mocap` (Release) and runs the tracker on its
-# simulated default: renders a recording of the built-in shoulder rig with ground
-# truth, tracks it offline through the same stages as the live pipeline, and prints a
-# summary with the accuracy against the ground truth and the per-stage timings.
+# simulated default: renders recordings of the built-in shoulder rig with ground truth,
+# calibrates the joints, tracks offline through the same stages as the live pipeline
+# (printing the accuracy against the ground truth and the per-stage timings), then runs
+# the live pipeline on simulated cameras for 5 s and prints its latency statistics.
 # This is the README's first command.
 # Usage: bash deploy/demo.sh [OUTPUT_DIR]     (default: ./out/demo)
 set -euo pipefail
@@ -28,3 +29,5 @@ echo "== mocap track"
 "$mocap" track "$out/rec" --targets "$out/rec/targets.yaml" --model "$out/model.yaml" \
   --out "$out/track" --stats "$out/track/stats.json" --truth "$out/rec/gt"
 echo "== outputs in $out/track: points.csv poses.csv angles.csv stats.json"
+echo "== mocap run (live pipeline on simulated cameras, UDP to 127.0.0.1:7755, 5 s)"
+"$mocap" run --duration 5 --stats "$out/run-stats.json"
