@@ -2,7 +2,7 @@
 // slicing-by-8, vs zlib's crc32 as the baseline), encode_datagram (packing + CRC) and
 // decode_datagram (validation + unpacking) for 1, 8 and 32 joints, and UdpPublisher ->
 // UdpReceiver on 127.0.0.1 (sendto + recv per message). Loopback only. With a running
-// iox-roudi (start it yourself, e.g. with the small config of docs/performance/publish.md)
+// iox-roudi (start it yourself, e.g. with the small config of docs/performance.md (live output section))
 // also the iceoryx loan + copy + publish, and publish + take; otherwise those are skipped.
 #include <benchmark/benchmark.h>
 #include <unistd.h>
