@@ -120,5 +120,8 @@ class Camera {
 
 // CLOCK_MONOTONIC in ns (the clock of every timestamp in the HAL and the live output).
 std::int64_t monotonic_ns() noexcept;
+// Sleeps until an absolute CLOCK_MONOTONIC deadline (no drift over long runs; restarts
+// after signals).
+void sleep_until_ns(std::int64_t deadline_ns) noexcept;
 
 }  // namespace mocap::hal

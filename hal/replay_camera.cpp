@@ -9,14 +9,6 @@ namespace {
 
 constexpr int kMaxBuffers = 32;
 
-void sleep_until_ns(std::int64_t deadline_ns) noexcept {
-  timespec ts{};
-  ts.tv_sec = deadline_ns / 1'000'000'000;
-  ts.tv_nsec = deadline_ns % 1'000'000'000;
-  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) != 0) {
-  }
-}
-
 }  // namespace
 
 Expected<std::unique_ptr<ReplayCamera>> ReplayCamera::open(

@@ -16,14 +16,6 @@ namespace {
 
 constexpr int kMaxBuffers = 64;
 
-void sleep_until_ns(std::int64_t deadline_ns) noexcept {
-  timespec ts{};
-  ts.tv_sec = deadline_ns / 1'000'000'000;
-  ts.tv_nsec = deadline_ns % 1'000'000'000;
-  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) != 0) {
-  }
-}
-
 }  // namespace
 
 Expected<std::shared_ptr<const SimFrameLoop>> SimFrameLoop::render(const sim::SimOptions& options) {
