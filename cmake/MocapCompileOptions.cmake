@@ -10,6 +10,13 @@ if(MOCAP_SANITIZE)
   string(REPLACE ";" "," _mocap_san "${MOCAP_SANITIZE}")
   add_compile_options(-fsanitize=${_mocap_san} -fno-omit-frame-pointer -fno-sanitize-recover=all)
   add_link_options(-fsanitize=${_mocap_san})
+  if("address" IN_LIST MOCAP_SANITIZE)
+    # Eigen switches to its hand-made aligned malloc under ASan, while Debian's libceres
+    # (built without ASan) frees Eigen storage with plain free(): the mix is a bad free.
+    # glibc's and ASan's malloc both return 16-byte-aligned memory, which is all Eigen
+    # needs here (no AVX flags), so keep Eigen on plain malloc everywhere.
+    add_compile_definitions(EIGEN_MALLOC_ALREADY_ALIGNED=1)
+  endif()
   message(STATUS "mocap: sanitizers ${_mocap_san}")
 endif()
 
