@@ -121,21 +121,30 @@ RelativePose relative_pose(const Iso3& T_world_parent, const Iso3& T_world_child
                       Rt * (T_world_child.translation() - T_world_parent.translation())};
 }
 
-Expected<BallEstimate> estimate_ball(const std::vector<RelativePose>& poses,
-                                     const LinearOptions& options, const std::string& label) {
+// The paper's Eq. 2 system [I  -R_i] [c_p; c_c] = t_i over the relative poses; an
+// empty string on success, else the one-line error.
+static std::string build_eq2(const std::vector<RelativePose>& poses,
+                             const LinearOptions& options,
+                             const std::string& label, Eigen::MatrixXd& A, Eigen::VectorXd& b) {
   const int n = static_cast<int>(poses.size());
-  if (auto e = check_count(n, options, label); !e.empty()) return Error{e};
+  if (auto e = check_count(n, options, label); !e.empty()) return e;
   for (const auto& p : poses) {
-    if (!finite_pose(p)) return Error{label + ": non-finite relative pose"};
+    if (!finite_pose(p)) return label + ": non-finite relative pose";
   }
-  Eigen::MatrixXd A;
-  Eigen::VectorXd b;
   build(n, A, b, [&](int i, auto block, auto rhs) {
     const auto& p = poses[static_cast<std::size_t>(i)];
     block.template leftCols<3>().setIdentity();
     block.template rightCols<3>() = -p.R_parent_child;
     rhs = p.t_parent_child;
   });
+  return {};
+}
+
+Expected<BallEstimate> estimate_ball(const std::vector<RelativePose>& poses,
+                                     const LinearOptions& options, const std::string& label) {
+  Eigen::MatrixXd A;
+  Eigen::VectorXd b;
+  if (auto e = build_eq2(poses, options, label, A, b); !e.empty()) return Error{e};
   return ball_from_system(A, b, options, label);
 }
 
@@ -163,19 +172,9 @@ Expected<BallEstimate> estimate_ball_world(const std::vector<Iso3>& T_world_pare
 Expected<HingeEstimate> estimate_hinge(const std::vector<RelativePose>& poses,
                                        const LinearOptions& options, const std::string& label,
                                        const Vec3& sign_hint_parent) {
-  const int n = static_cast<int>(poses.size());
-  if (auto e = check_count(n, options, label); !e.empty()) return Error{e};
-  for (const auto& p : poses) {
-    if (!finite_pose(p)) return Error{label + ": non-finite relative pose"};
-  }
   Eigen::MatrixXd A;
   Eigen::VectorXd b;
-  build(n, A, b, [&](int i, auto block, auto rhs) {
-    const auto& p = poses[static_cast<std::size_t>(i)];
-    block.template leftCols<3>().setIdentity();
-    block.template rightCols<3>() = -p.R_parent_child;
-    rhs = p.t_parent_child;
-  });
+  if (auto e = build_eq2(poses, options, label, A, b); !e.empty()) return Error{e};
   const Svd6 s = decompose(A);
   const Eigen::Matrix<double, 6, 1> x = solve(s, b, 5);
   HingeEstimate out;
