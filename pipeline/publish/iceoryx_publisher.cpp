@@ -14,9 +14,9 @@ struct IceoryxPublisher::Impl {
   explicit Impl(const iox::popo::PublisherOptions& options)
       : pub(
             iox::capro::ServiceDescription{
-                iox::capro::IdString_t(iox::cxx::TruncateToCapacity, client::kIceoryxService),
-                iox::capro::IdString_t(iox::cxx::TruncateToCapacity, client::kIceoryxInstance),
-                iox::capro::IdString_t(iox::cxx::TruncateToCapacity, client::kIceoryxEvent)},
+                iox::capro::IdString_t(client::kIceoryxService),
+                iox::capro::IdString_t(client::kIceoryxInstance),
+                iox::capro::IdString_t(client::kIceoryxEvent)},
             options) {}
   iox::popo::Publisher<client::JointsMessage> pub;
 };

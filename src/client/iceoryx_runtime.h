@@ -14,9 +14,11 @@
 
 namespace mocap::client {
 
-inline constexpr const char* kIceoryxService = "mocap";
-inline constexpr const char* kIceoryxInstance = "tracker";
-inline constexpr const char* kIceoryxEvent = "joints";
+// Arrays, not pointers: iceoryx's IdString_t(const char (&)[N]) checks the length at compile
+// time, while its truncating const char* constructor trips GCC 12's -Warray-bounds at -O1.
+inline constexpr char kIceoryxService[] = "mocap";
+inline constexpr char kIceoryxInstance[] = "tracker";
+inline constexpr char kIceoryxEvent[] = "joints";
 
 // Fails fast, never blocks: "iceoryx: RouDi (iox-roudi) not running" when RouDi is absent.
 // `roudi_socket_path` exists for tests; production uses the default /tmp/roudi.

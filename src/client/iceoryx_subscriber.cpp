@@ -12,9 +12,9 @@ struct IceoryxSubscriber::Impl {
   explicit Impl(const iox::popo::SubscriberOptions& options)
       : sub(
             iox::capro::ServiceDescription{
-                iox::capro::IdString_t(iox::cxx::TruncateToCapacity, kIceoryxService),
-                iox::capro::IdString_t(iox::cxx::TruncateToCapacity, kIceoryxInstance),
-                iox::capro::IdString_t(iox::cxx::TruncateToCapacity, kIceoryxEvent)},
+                iox::capro::IdString_t(kIceoryxService),
+                iox::capro::IdString_t(kIceoryxInstance),
+                iox::capro::IdString_t(kIceoryxEvent)},
             options) {}
   iox::popo::Subscriber<JointsMessage> sub;
 };
