@@ -41,6 +41,11 @@ Expected<std::unique_ptr<Pipeline>> Pipeline::create(FrameProcessor processor,
   if (options.dequeue_timeout_ms < 1 || options.dequeue_timeout_ms > 1000) {
     return make_error("pipeline", "dequeue_timeout_ms", "must be in 1..1000");
   }
+  if (options.pair_by == PairBy::kTimestamp &&
+      (options.pair_tolerance_us < 1 || options.pair_tolerance_us > 1'000'000)) {
+    return make_error("pipeline", "pair_tolerance_us",
+                      "must be in 1..1000000 us, got " + std::to_string(options.pair_tolerance_us));
+  }
   for (const StageSpec& s : options.stages) {
     if (auto v = rt::validate(rt::ThreadSpec{s.name, s.cpu, s.fifo_priority}); !v)
       return make_error("pipeline", std::string("stages: ") + s.name, v.error().message);
@@ -106,24 +111,23 @@ Expected<void> Pipeline::start() {
                                     [](std::uint32_t) { return MsgSlot{}; });
   if (!msg_pool) return msg_pool.error();
   msg_pool_ = std::make_unique<rt::SlotPool<MsgSlot>>(std::move(msg_pool).value());
+  const std::int64_t tolerance =
+      options_.pair_by == PairBy::kTimestamp ? options_.pair_tolerance_us * 1000 : 0;
   auto pairer = hal::FramePairer::create(
-      hal::PairerConfig{0, options_.stages[index(StageId::kIdentify)].ring_depth});
+      hal::PairerConfig{tolerance, options_.stages[index(StageId::kIdentify)].ring_depth});
   if (!pairer) return pairer.error();
   pairer_ = std::make_unique<hal::FramePairer>(std::move(pairer).value());
   out_ = std::make_unique<FrameOutput>(processor_.make_output());
   counters_ = std::make_unique<Counters>();
-  lat_ = std::make_unique<Latencies>();
-  for (LatencyRecorder* r :
-       {&lat_->detect[0], &lat_->detect[1], &lat_->detect_work[0], &lat_->detect_work[1],
-        &lat_->identify, &lat_->identify_work, &lat_->publish, &lat_->sink_work}) {
-    r->reserve(options_.latency_capacity);
-  }
+  lat_ = std::make_unique<Latencies>();  // value-initialised: every bucket 0
   processor_.reset();
   stop_.store(false, std::memory_order_relaxed);  // no thread runs yet
   triggering_done_.store(false, std::memory_order_relaxed);
   published_.store(0, std::memory_order_relaxed);
   last_publish_ns_.store(0, std::memory_order_relaxed);
   retired_.store(0, std::memory_order_relaxed);
+  publish_period_ns_.store(0, std::memory_order_relaxed);
+  first_sequence_.store(0, std::memory_order_relaxed);
 
   if (options_.lock_memory) {
     if (std::string note = rt::lock_memory(); !note.empty()) notes_.push_back(note);
@@ -136,6 +140,7 @@ Expected<void> Pipeline::start() {
   }
   start_ns_ = monotonic_ns();
   stop_ns_ = 0;
+  for (auto& t : last_frame_ns_) t.store(0, std::memory_order_relaxed);  // no frame yet
   threads_.clear();
   // Consumers first, so that no producer ever runs ahead of a missing consumer.
   const StageId order[] = {StageId::kPublish, StageId::kIdentify, StageId::kDetect0,
@@ -259,9 +264,18 @@ void Pipeline::capture_loop() noexcept {
       }
       // Both pacings: at most trigger_rate_hz (lockstep may trigger later, never earlier).
       sleep_until_ns(next_trigger_ns);
-      next_trigger_ns += period_ns;
       const std::int64_t now = monotonic_ns();
-      if (next_trigger_ns < now) next_trigger_ns = now + period_ns;  // overran: re-phase
+      // How late this trigger fires (the capture thread was not scheduled in time, or a
+      // camera call overran): invisible in the latencies, which start at the trigger.
+      const auto late_us =
+          static_cast<std::uint64_t>(std::max<std::int64_t>(now - next_trigger_ns, 0) / 1000);
+      if (late_us > k.trigger_late_max_us.get())
+        k.trigger_late_max_us.add(late_us - k.trigger_late_max_us.get());
+      next_trigger_ns += period_ns;
+      if (next_trigger_ns < now) {  // overran a whole period: re-phase, triggers skipped
+        k.trigger_overruns.add(static_cast<std::uint64_t>((now - next_trigger_ns) / period_ns) + 1);
+        next_trigger_ns = now + period_ns;
+      }
       for (int c = 0; c < 2; ++c) {
         if (software[c] &&
             cameras_[static_cast<std::size_t>(c)]->trigger() != hal::CameraStatus::kOk)
@@ -269,32 +283,46 @@ void Pipeline::capture_loop() noexcept {
       }
       k.triggered.add();
     }
+    // Wait for each camera's frame at most dequeue_timeout_ms and never past the next
+    // trigger (a stalled camera must not delay the other one or the trigger), then drain
+    // whatever else is ready (a camera that caught up after a stall).
     std::uint64_t last_sequence = 0;
     bool pushed = false;
     for (int c = 0; c < 2; ++c) {
       hal::Camera& cam = *cameras_[static_cast<std::size_t>(c)];
-      hal::Frame f;
-      const hal::CameraStatus st = cam.dequeue(f, triggered_mode ? options_.dequeue_timeout_ms : 5);
-      if (st == hal::CameraStatus::kTimeout || st == hal::CameraStatus::kAgain) {
-        k.dequeue_timeouts.add();
-        continue;
+      int timeout_ms = 5;  // free-run: the two cameras are polled in turn
+      if (triggered_mode) {
+        const std::int64_t left_ns = next_trigger_ns - monotonic_ns();
+        const std::int64_t left_ms = (left_ns + 999'999) / 1'000'000;  // round up
+        timeout_ms =
+            static_cast<int>(std::clamp<std::int64_t>(left_ms, 0, options_.dequeue_timeout_ms));
       }
-      if (st == hal::CameraStatus::kEndOfStream) {
-        triggering_done_.store(true, std::memory_order_release);  // see above
-        continue;
-      }
-      if (st != hal::CameraStatus::kOk) {
-        k.dequeue_errors.add();
-        continue;
-      }
-      if (!triggered_mode && c == 0) k.triggered.add();
-      last_sequence = f.sequence;
-      if (to_detect_[static_cast<std::size_t>(c)]->try_push(f)) {
-        pushed = true;
-        bells_[index(StageId::kDetect0) + static_cast<std::size_t>(c)].ring();
-      } else {  // the detector holds every slot (stalled): drop this frame
-        k.capture_ring_full[c].add();
-        if (cam.release(f) != hal::CameraStatus::kOk) k.release_errors.add();
+      const int max_frames = cam.config().buffer_count;
+      for (int n = 0; n < max_frames; ++n) {
+        hal::Frame f;
+        const hal::CameraStatus st = cam.dequeue(f, n == 0 ? timeout_ms : 0);
+        if (st == hal::CameraStatus::kTimeout || st == hal::CameraStatus::kAgain) {
+          if (n == 0) k.dequeue_timeouts[c].add();
+          break;
+        }
+        if (st == hal::CameraStatus::kEndOfStream) {
+          triggering_done_.store(true, std::memory_order_release);  // see above
+          break;
+        }
+        if (st != hal::CameraStatus::kOk) {
+          k.dequeue_errors.add();
+          break;
+        }
+        on_frame_received(c, f.sequence);
+        if (!triggered_mode && c == 0) k.triggered.add();
+        last_sequence = f.sequence;
+        if (to_detect_[static_cast<std::size_t>(c)]->try_push(f)) {
+          pushed = true;
+          bells_[index(StageId::kDetect0) + static_cast<std::size_t>(c)].ring();
+        } else {  // the detector holds every slot (stalled): drop this frame
+          k.capture_ring_full[c].add();
+          if (cam.release(f) != hal::CameraStatus::kOk) k.release_errors.add();
+        }
       }
     }
     if (pushed && triggered_mode && options_.pacing == TriggerPacing::kLockstep) {
@@ -310,6 +338,24 @@ void Pipeline::capture_loop() noexcept {
     }
   }
   if (options_.hooks) options_.hooks->on_loop_end(StageId::kCapture);
+}
+
+void Pipeline::on_frame_received(int camera, std::uint64_t sequence) noexcept {
+  const auto c = static_cast<std::size_t>(camera);
+  const std::int64_t now = monotonic_ns();
+  // relaxed: a single writer (capture); readers only want a recent, untorn time.
+  const std::int64_t last = last_frame_ns_[c].load(std::memory_order_relaxed);
+  last_frame_ns_[c].store(now, std::memory_order_relaxed);
+  if (last != 0) {  // between two frames (start-up, before the first frame, excluded)
+    rt::Counter& max_silence = counters_->camera_max_silence_us[c];
+    const auto silent_us = static_cast<std::uint64_t>(std::max<std::int64_t>(now - last, 0) / 1000);
+    if (silent_us > max_silence.get()) max_silence.add(silent_us - max_silence.get());
+  }
+  if (first_sequence_.load(std::memory_order_relaxed) == 0) {
+    // release: published before this frame enters any ring; identify reads it after
+    // receiving a later frame through the rings (acquire), so it sees the value.
+    first_sequence_.store(sequence + 1, std::memory_order_release);
+  }
 }
 
 void Pipeline::detect_loop(int camera) noexcept {
@@ -365,11 +411,32 @@ void Pipeline::identify_loop() noexcept {
   hal::FramePairer& pairer = *pairer_;
   FrameOutput& out = *out_;
   auto on_drop = [&](int c, const hal::PairEntry& e) {
-    blob_pools_[static_cast<std::size_t>(c)]->release(e.handle);
-    retire(static_cast<std::uint64_t>(e.key));
+    rt::SlotPool<BlobSlot>& pool = *blob_pools_[static_cast<std::size_t>(c)];
+    const std::uint64_t sequence = pool[e.handle].sequence;
+    pool.release(e.handle);
+    retire(sequence);
   };
+  const bool by_time = options_.pair_by == PairBy::kTimestamp;
+  std::uint64_t next_sequence = 0;  // the first sequence not yet accounted for
+  bool counting = false;
   bool have_pair = false;
   hal::FramePair pair{};
+  // Sequences between two consecutive pairs never formed a pair (dropped by a camera, the
+  // capture, a detector or the pairer): counted once each, when the next pair forms
+  // (pairs form in increasing sequence order). Pairs dropped later are counted by the
+  // stage that drops them (identify_skipped, identify_no_slot, publish_skipped).
+  auto count_unpaired = [&](std::uint64_t sequence) {
+    if (!counting) {
+      // acquire: see on_frame_received(); the capture stored it before any push.
+      const std::uint64_t first = first_sequence_.load(std::memory_order_acquire);
+      next_sequence = first == 0 ? sequence : first - 1;
+      counting = true;
+    }
+    if (sequence >= next_sequence) {
+      k.frames_unpaired.add(sequence - next_sequence);
+      next_sequence = sequence + 1;
+    }
+  };
   while (!stopping()) {
     const std::uint32_t seen = bell.snapshot();
     for (int c = 0; c < 2; ++c) {
@@ -377,8 +444,11 @@ void Pipeline::identify_loop() noexcept {
       rt::SlotHandle h;
       while (pool.pop(h)) {
         hal::FramePair p;
-        const hal::PairEntry e{static_cast<std::int64_t>(pool[h].sequence), h};
+        const std::int64_t key =
+            by_time ? pool[h].capture_ns : static_cast<std::int64_t>(pool[h].sequence);
+        const hal::PairEntry e{key, h};
         if (!pairer.push(c, e, p, on_drop)) continue;
+        count_unpaired((*blob_pools_[0])[p.cam[0].handle].sequence);
         if (have_pair) {  // drop-oldest: a newer pair is complete
           k.identify_skipped.add();
           on_drop(0, pair.cam[0]);
@@ -409,6 +479,8 @@ void Pipeline::identify_loop() noexcept {
     rt::SlotHandle m;
     if (msg_pool_->acquire(m)) {
       make_joints_message(sequence, capture_ns, out, (*msg_pool_)[m].msg);
+      if (((*msg_pool_)[m].msg.flags & client::kFlagAllBodiesFound) == 0)
+        k.frames_without_result.add();
       msg_pool_->publish(m);
       bells_[index(StageId::kPublish)].ring();
     } else {  // publish holds every slot (stalled sink)
@@ -428,6 +500,7 @@ void Pipeline::publish_loop() noexcept {
   Counters& k = *counters_;
   rt::SlotPool<MsgSlot>& pool = *msg_pool_;
   std::uint64_t skipped_seen = 0;
+  std::int64_t prev_publish_ns = 0;
   while (!stopping()) {
     const std::uint32_t seen = bell.snapshot();
     rt::SlotHandle h;
@@ -447,6 +520,13 @@ void Pipeline::publish_loop() noexcept {
     }
     const std::int64_t t1 = monotonic_ns();
     const std::uint64_t sequence = msg.sequence;
+    if (prev_publish_ns != 0) {  // publish period, exponential average over ~16 frames
+      const std::int64_t ema = publish_period_ns_.load(std::memory_order_relaxed);
+      const std::int64_t dt = t0 - prev_publish_ns;
+      // relaxed: single writer; health() only wants a recent, untorn value.
+      publish_period_ns_.store(ema == 0 ? dt : ema + (dt - ema) / 16, std::memory_order_relaxed);
+    }
+    prev_publish_ns = t0;
     lat_->sink_work.record(t1 - t0);
     lat_->publish.record(t0 - msg.capture_ns);
     pool.release(h);
@@ -458,29 +538,60 @@ void Pipeline::publish_loop() noexcept {
   if (options_.hooks) options_.hooks->on_loop_end(StageId::kPublish);
 }
 
+PipelineHealth Pipeline::health() const noexcept {
+  PipelineHealth h;
+  if (!counters_) return h;
+  const Counters& k = *counters_;
+  h.frames_published = frames_published();  // acquire (see there), then the time:
+  h.last_publish_ns = last_publish_ns();
+  h.frames_triggered = k.triggered.get();
+  h.frames_dropped = k.frames_unpaired.get() + k.identify_skipped.get() + k.identify_no_slot.get() +
+                     k.publish_skipped.get();
+  const std::int64_t now = monotonic_ns();
+  // relaxed: independent single-writer values, each only needs to be untorn and recent.
+  const std::int64_t period = publish_period_ns_.load(std::memory_order_relaxed);
+  if (period > 0 && h.last_publish_ns != 0 && now - h.last_publish_ns < 1'000'000'000)
+    h.fps = 1e9 / static_cast<double>(period);
+  h.p99_us = lat_->publish.percentile_us(0.99);
+  h.max_us = static_cast<double>(lat_->publish.max_ns()) * 1e-3;
+  for (std::size_t c = 0; c < 2; ++c) {
+    const std::int64_t last = last_frame_ns_[c].load(std::memory_order_relaxed);
+    // Before its first frame a camera has been silent since start().
+    const std::int64_t since = last != 0 ? last : start_ns_;
+    h.camera_silent_ms[c] = !stopping() ? (now - since) / 1'000'000 : 0;
+  }
+  return h;
+}
+
 PipelineStats Pipeline::stats() const {
   PipelineStats s;
   if (!counters_) return s;
   const Counters& k = *counters_;
   const std::int64_t end = stop_ns_ != 0 ? stop_ns_ : monotonic_ns();
   s.duration_s = static_cast<double>(end - start_ns_) * 1e-9;
+  const PipelineHealth h = health();
   s.triggered = k.triggered.get();
   s.published = frames_published();
   s.fps = s.duration_s > 0.0 ? static_cast<double>(s.published) / s.duration_s : 0.0;
-  s.latency = {{"detect0", lat_->detect[0].summary()},
-               {"detect1", lat_->detect[1].summary()},
-               {"identify", lat_->identify.summary()},
-               {"publish", lat_->publish.summary()},
-               {"detect0_work", lat_->detect_work[0].summary()},
-               {"detect1_work", lat_->detect_work[1].summary()},
-               {"identify_work", lat_->identify_work.summary()},
-               {"sink_work", lat_->sink_work.summary()}};
+  s.latency = {{"detect0", lat_->detect[0].stats()},
+               {"detect1", lat_->detect[1].stats()},
+               {"identify", lat_->identify.stats()},
+               {"publish", lat_->publish.stats()},
+               {"detect0_work", lat_->detect_work[0].stats()},
+               {"detect1_work", lat_->detect_work[1].stats()},
+               {"identify_work", lat_->identify_work.stats()},
+               {"sink_work", lat_->sink_work.stats()}};
   const hal::PairerCounters& pc = pairer_->counters();
   s.counters = {
       {"triggered", k.triggered.get()},
       {"published", s.published},
       {"trigger_errors", k.trigger_errors.get()},
-      {"dequeue_timeouts", k.dequeue_timeouts.get()},
+      {"trigger_overruns", k.trigger_overruns.get()},
+      {"trigger_late_max_us", k.trigger_late_max_us.get()},
+      {"dequeue_timeouts_cam0", k.dequeue_timeouts[0].get()},
+      {"dequeue_timeouts_cam1", k.dequeue_timeouts[1].get()},
+      {"camera_max_silence_us_cam0", k.camera_max_silence_us[0].get()},
+      {"camera_max_silence_us_cam1", k.camera_max_silence_us[1].get()},
       {"dequeue_errors", k.dequeue_errors.get()},
       {"release_errors", k.release_errors.get()},
       {"capture_dropped_cam0", k.capture_ring_full[0].get()},
@@ -497,10 +608,13 @@ PipelineStats Pipeline::stats() const {
       {"pair_unmatched_cam1", pc.unmatched[1].get()},
       {"pair_overflow_cam0", pc.overflow[0].get()},
       {"pair_overflow_cam1", pc.overflow[1].get()},
+      {"frames_unpaired", k.frames_unpaired.get()},
       {"identify_skipped", k.identify_skipped.get()},
       {"identify_no_slot", k.identify_no_slot.get()},
       {"publish_skipped", k.publish_skipped.get()},
       {"sink_failures", k.sink_failures.get()},
+      {"frames_dropped", h.frames_dropped},
+      {"frames_without_result", k.frames_without_result.get()},
   };
   return s;
 }

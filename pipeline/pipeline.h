@@ -14,9 +14,12 @@
 // the NEWEST item, returning the older ones (counted as skipped); a producer whose
 // consumer has stalled long enough to hold every slot drops the incoming item (counted).
 // Pairing: FramePairer by trigger sequence (tolerance 0; unmatched frames counted).
+// Pairing: by trigger sequence (tolerance 0) or, for free-running cameras, by sensor
+// timestamp within PipelineOptions::pair_tolerance_us.
 // Latency: every sample is measured from the frame's trigger timestamp (Frame.timestamp_ns)
-// on CLOCK_MONOTONIC: detect done, identify done, published (end to end).
-// Health: frames_published() / last_publish_ns() may be read from any thread.
+// on CLOCK_MONOTONIC: detect done, identify done, published (end to end), into
+// LatencyHistograms that any thread may read while the pipeline runs.
+// Health: health(), frames_published() and last_publish_ns() may be read from any thread.
 #pragma once
 
 #include <array>
@@ -37,6 +40,7 @@
 #include "hal/rt/thread.h"
 #include "pipeline/doorbell.h"
 #include "pipeline/joints_sink.h"
+#include "pipeline/latency_histogram.h"
 #include "pipeline/stage_table.h"
 #include "track/frame_processor.h"
 
@@ -46,6 +50,11 @@ enum class TriggerPacing : std::uint8_t {
   kPeriodic,  // software trigger every 1/trigger_rate_hz (absolute deadlines, no drift)
   kLockstep,  // next trigger once the previous frame was published or dropped, and at
               // most at trigger_rate_hz (replays, tests: lossless)
+};
+
+enum class PairBy : std::uint8_t {
+  kSequence,   // trigger sequence numbers must match (triggered cameras)
+  kTimestamp,  // sensor timestamps within pair_tolerance_us (free-running cameras)
 };
 
 // Called on the identify thread with every processed frame (tests, recording).
@@ -72,10 +81,30 @@ struct PipelineOptions {
   double trigger_rate_hz = 100.0;  // software-triggered cameras
   TriggerPacing pacing = TriggerPacing::kPeriodic;
   std::uint64_t max_frames = 0;  // stop triggering after this many (0: unlimited)
+  // Longest wait for a triggered frame; the capture also never waits past the next
+  // trigger, so a stalled camera cannot slow the other one down.
   int dequeue_timeout_ms = 20;
-  std::size_t latency_capacity = 1u << 16;  // samples kept per statistic (max always exact)
+  PairBy pair_by = PairBy::kSequence;
+  // kTimestamp only: two frames pair when their timestamps differ by at most this; must
+  // be below half the frame period.
+  std::int64_t pair_tolerance_us = 1000;
   FrameObserver* observer = nullptr;
   StageHooks* hooks = nullptr;
+};
+
+// A cheap view of the running pipeline for a supervisor (systemd watchdog, status line):
+// health() reads only atomics (no lock, no allocation; ~2 k relaxed loads for p99).
+struct PipelineHealth {
+  std::uint64_t frames_triggered = 0;
+  std::uint64_t frames_published = 0;
+  // Triggered frames known to be lost (never published): the sum of the sequence-level
+  // drop counters (frames_unpaired + identify_skipped + identify_no_slot + publish_skipped).
+  std::uint64_t frames_dropped = 0;
+  double fps = 0.0;     // publish rate over the last ~16 frames; 0 after 1 s without one
+  double p99_us = 0.0;  // trigger-to-publish p99 since start()
+  double max_us = 0.0;  // trigger-to-publish max since start()
+  std::int64_t last_publish_ns = 0;           // CLOCK_MONOTONIC; 0: nothing published yet
+  std::int64_t camera_silent_ms[2] = {0, 0};  // time since camera c last delivered a frame
 };
 
 struct PipelineStats {
@@ -83,9 +112,9 @@ struct PipelineStats {
   std::uint64_t triggered = 0;
   std::uint64_t published = 0;
   double fps = 0.0;  // published / duration
-  // (name, summary): detect0/detect1/identify/publish are latencies from the trigger;
-  // *_work are the stage's own processing times.
-  std::vector<std::pair<std::string, LatencySummary>> latency;
+  // (name, summary): detect0/detect1/identify/publish are latencies from the trigger
+  // ("publish" is trigger-to-publish, end to end); *_work are the stage's own times.
+  std::vector<std::pair<std::string, LatencyStats>> latency;
   std::vector<std::pair<std::string, std::uint64_t>> counters;
 };
 
@@ -113,7 +142,9 @@ class Pipeline {
 
   const std::vector<std::string>& notes() const noexcept { return notes_; }
 
-  // Health, any thread.
+  // Health, any thread (see PipelineHealth) except concurrently with start(), which
+  // rebuilds the counters. Zeroes before the first start().
+  PipelineHealth health() const noexcept;
   std::uint64_t frames_published() const noexcept {
     // acquire: pairs with the publish thread's release increment, so last_publish_ns()
     // read after this is at least as recent as the publish counted here.
@@ -124,8 +155,11 @@ class Pipeline {
     return last_publish_ns_.load(std::memory_order_relaxed);
   }
 
-  // After stop() (or from the owner thread while running: counters are approximate).
+  // The owner thread (the one calling start/stop), also while running: every value is
+  // read atomically, values at slightly different instants. Report time: allocates.
   PipelineStats stats() const;
+  // The trigger-to-publish histogram (any thread; periodic interval reports).
+  const LatencyHistogram* end_to_end() const noexcept { return lat_ ? &lat_->publish : nullptr; }
   const FrameProcessor& processor() const noexcept { return processor_; }
 
  private:
@@ -139,14 +173,19 @@ class Pipeline {
     client::JointsMessage msg;
   };
   struct Counters {
-    rt::Counter triggered, trigger_errors, dequeue_timeouts, dequeue_errors;
+    rt::Counter triggered, trigger_errors, dequeue_timeouts[2], dequeue_errors;
+    rt::Counter trigger_overruns;     // trigger periods skipped (capture late by >= 1 period)
+    rt::Counter trigger_late_max_us;  // latest trigger vs its deadline
     rt::Counter capture_ring_full[2], release_errors;
+    rt::Counter camera_max_silence_us[2];  // longest interval without a frame (a stall)
     rt::Counter detect_skipped[2], detect_no_slot[2];
+    rt::Counter frames_unpaired;  // sequences that never formed a pair (identify)
     rt::Counter identify_skipped, identify_no_slot;
+    rt::Counter frames_without_result;  // processed, but not every body found
     rt::Counter publish_skipped, sink_failures;
   };
   struct Latencies {
-    LatencyRecorder detect[2], detect_work[2], identify, identify_work, publish, sink_work;
+    LatencyHistogram detect[2], detect_work[2], identify, identify_work, publish, sink_work;
   };
 
   Pipeline(FrameProcessor processor, std::array<hal::Camera*, 2> cameras,
@@ -157,6 +196,7 @@ class Pipeline {
   void identify_loop() noexcept;
   void publish_loop() noexcept;
   void release_returned() noexcept;
+  void on_frame_received(int camera, std::uint64_t sequence) noexcept;
   void retire(std::uint64_t sequence) noexcept;
   bool stopping() const noexcept { return stop_.load(std::memory_order_acquire); }
   void drain_after_join() noexcept;
@@ -184,6 +224,10 @@ class Pipeline {
   std::atomic<bool> triggering_done_{false};
   std::atomic<std::uint64_t> published_{0};
   std::atomic<std::int64_t> last_publish_ns_{0};
+  std::atomic<std::int64_t> publish_period_ns_{0};   // EMA, publish thread writes
+  std::atomic<std::int64_t> last_frame_ns_[2] = {};  // capture thread writes
+  // First sequence the capture thread dequeued (+1; 0: none yet): the start of the gaps.
+  std::atomic<std::uint64_t> first_sequence_{0};
   // Highest sequence the identify/publish path has finished with (+1; 0: none).
   std::atomic<std::uint64_t> retired_{0};
 };

@@ -6,7 +6,7 @@
 namespace mocap::publish {
 
 Expected<Publishers> Publishers::create(const PublishersConfig& config) {
-  auto udp = UdpPublisher::create(config.udp_destinations);
+  auto udp = UdpPublisher::create(config.udp_destinations, config.multicast);
   if (!udp) return udp.error();
   Publishers p(std::move(udp.value()));
   p.stamped_ = std::make_unique<client::JointsMessage>();

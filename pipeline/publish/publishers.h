@@ -21,6 +21,7 @@ namespace mocap::publish {
 
 struct PublishersConfig {
   std::vector<std::string> udp_destinations;  // "HOST:PORT"; may be empty
+  UdpMulticastOptions multicast;              // used when a destination is a group
   bool iceoryx = true;                        // try shared memory (needs iox-roudi)
   std::string iceoryx_app_name = "mocap_tracker";
   const char* roudi_socket_path = "/tmp/roudi";  // tests only

@@ -1,6 +1,8 @@
 // Design: see udp_publisher.h.
 #include "pipeline/publish/udp_publisher.h"
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
@@ -12,19 +14,59 @@
 
 namespace mocap::publish {
 
-Expected<UdpPublisher> UdpPublisher::create(const std::vector<std::string>& destinations) {
+Expected<UdpPublisher> UdpPublisher::create(const std::vector<std::string>& destinations,
+                                            const UdpMulticastOptions& multicast) {
   std::vector<sockaddr_in> addrs;
+  bool any_multicast = false;
   addrs.reserve(destinations.size());
   for (const std::string& d : destinations) {
     auto addr = client::parse_udp_endpoint(d, "udp publisher");
     if (!addr) return addr.error();
     if (addr->sin_port == 0)
       return make_error("udp publisher", "'" + d + "'", "port 0 is not a destination");
+    any_multicast = any_multicast || IN_MULTICAST(ntohl(addr->sin_addr.s_addr));
     addrs.push_back(addr.value());
+  }
+  if (multicast.ttl < 0 || multicast.ttl > 255)
+    return make_error("udp publisher", "multicast ttl", "must be in 0..255");
+  in_addr iface{};
+  if (!multicast.interface.empty() &&
+      ::inet_pton(AF_INET, multicast.interface.c_str(), &iface) != 1) {
+    return make_error("udp publisher", "multicast interface '" + multicast.interface + "'",
+                      "not an IPv4 address");
   }
   const int fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
   if (fd < 0) return Error{std::string("udp publisher: socket: ") + std::strerror(errno)};
-  return UdpPublisher(fd, std::move(addrs));
+  // One destination (the default): connect to it, so that the kernel drops datagrams
+  // from any other sender; the tracker never reads, and with several destinations the
+  // unread receive queue is bounded by the minimum buffer instead (docs/reliability.md).
+  // Best effort: sendto() below works either way.
+  if (addrs.size() == 1) {
+    (void)::connect(fd, reinterpret_cast<const sockaddr*>(&addrs[0]), sizeof(addrs[0]));
+  } else {
+    const int min_rcvbuf = 1;  // the kernel rounds up to its minimum
+    (void)::setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &min_rcvbuf, sizeof min_rcvbuf);
+  }
+  UdpPublisher pub(fd, std::move(addrs));  // owns fd from here
+  if (any_multicast) {
+    const auto set = [&](int option, const void* value, socklen_t len,
+                         const char* what) -> Expected<void> {
+      if (::setsockopt(fd, IPPROTO_IP, option, value, len) == 0) return {};
+      return make_error("udp publisher", what, std::strerror(errno));
+    };
+    const int ttl = multicast.ttl;
+    const int loop = multicast.loop ? 1 : 0;
+    if (auto r = set(IP_MULTICAST_TTL, &ttl, sizeof ttl, "IP_MULTICAST_TTL"); !r) return r.error();
+    if (auto r = set(IP_MULTICAST_LOOP, &loop, sizeof loop, "IP_MULTICAST_LOOP"); !r)
+      return r.error();
+    if (!multicast.interface.empty()) {
+      if (auto r = set(IP_MULTICAST_IF, &iface, sizeof iface,
+                       ("IP_MULTICAST_IF " + multicast.interface).c_str());
+          !r)
+        return r.error();
+    }
+  }
+  return pub;
 }
 
 UdpPublisher::UdpPublisher(int fd, std::vector<sockaddr_in> destinations) noexcept

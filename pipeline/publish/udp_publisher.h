@@ -3,6 +3,10 @@
 // port: the tracker sends only). publish() encodes datagram v1 into a preallocated
 // buffer and sendto()s each destination with MSG_DONTWAIT: noexcept, allocation-free,
 // no logging; transient errors (EAGAIN/ENOBUFS/ECONNREFUSED, ...) are only counted.
+// Multicast: when a destination is a multicast group (224.0.0.0/4), setup sets
+// IP_MULTICAST_TTL (hops, default 1: the local network), IP_MULTICAST_LOOP (default on:
+// consumers on this machine receive too) and, when given, IP_MULTICAST_IF (the local
+// interface address to send from; otherwise the kernel routes the group).
 #pragma once
 
 #include <netinet/in.h>
@@ -27,10 +31,17 @@ struct UdpPublisherCounters {
   std::uint64_t other_errors = 0;     // any other errno
 };
 
+struct UdpMulticastOptions {
+  int ttl = 1;            // IP_MULTICAST_TTL, 0..255
+  bool loop = true;       // IP_MULTICAST_LOOP
+  std::string interface;  // IP_MULTICAST_IF: IPv4 address of a local interface; empty: route
+};
+
 class UdpPublisher {
  public:
   // Fails with one line, e.g. "udp publisher: 'host:99999': port must be 0..65535".
-  static Expected<UdpPublisher> create(const std::vector<std::string>& destinations);
+  static Expected<UdpPublisher> create(const std::vector<std::string>& destinations,
+                                       const UdpMulticastOptions& multicast = {});
 
   UdpPublisher(UdpPublisher&& other) noexcept;
   UdpPublisher& operator=(UdpPublisher&& other) noexcept;

@@ -1,11 +1,21 @@
-// `mocap run [--udp HOST:PORT] [--duration SECONDS] [--stats FILE] [--rate HZ]
-// [--loop-frames N] [--no-realtime] [--no-iceoryx]`: the live tracker (pipeline/). With no
+// `mocap run [--udp HOST:PORT] [--multicast-if ADDR] [--multicast-ttl N] [--duration SECONDS]
+// [--stats FILE] [--stats-interval S] [--rate HZ] [--loop-frames N] [--no-realtime]
+// [--no-iceoryx]`: the live tracker (pipeline/). With no
 // configuration it runs on the simulated stereo pair of the built-in scenario (a
 // pre-rendered loop, hal/sim_camera.h) with the simulator's true joint model, and
 // publishes every frame over UDP (127.0.0.1:7755 by default) and iceoryx, through the
 // publishers of pipeline/publish when they are built in (MOCAP_HAVE_PUBLISH). --duration, SIGINT or
 // SIGTERM stop it cleanly (the signal handler only sets an atomic flag); it then prints the latency
-// statistics and, with --stats, writes them as JSON.
+// statistics and, with --stats, writes them as JSON. While running, every --stats-interval
+// seconds one progress line goes to stderr (pipeline::format_progress_line).
+// --config FILE runs the cameras, tracker, stage table and outputs of a configuration
+// file (docs/operations.md; flags given on the command line override it);
+// --check-config FILE only validates one. Under systemd (NOTIFY_SOCKET) the supervisor of
+// pipeline/service sends READY, WATCHDOG (only while frames progress) and STATUS.
+// Structure: parse (RunArgs) -> service::resolve_run_config -> service::LiveSetup (cameras,
+// tracker, options) -> make_sinks -> Pipeline::create/start -> supervise (periodic report,
+// sd_notify, stop conditions) -> report.
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <csignal>
@@ -16,8 +26,12 @@
 #include <vector>
 
 #include "app/command_registry.h"
-#include "hal/sim_camera.h"
+#include "hal/camera.h"
 #include "pipeline/pipeline.h"
+#include "pipeline/service/health_sink.h"
+#include "pipeline/service/live_setup.h"
+#include "pipeline/service/notifier.h"
+#include "pipeline/service/supervisor.h"
 #include "pipeline/stats_report.h"
 #ifdef MOCAP_HAVE_PUBLISH
 #include "pipeline/publish/publishers.h"
@@ -29,10 +43,32 @@ namespace {
 std::atomic<bool> g_stop_requested{false};
 static_assert(std::atomic<bool>::is_always_lock_free, "used from a signal handler");
 
-extern "C" void on_stop_signal(int) {
-  // relaxed: a lock-free atomic store is async-signal-safe; the main loop polls it.
+// Who sent the stop signal: iox-roudi SIGTERMs every registered client when it shuts down.
+std::atomic<int> g_stop_sender_pid{0};
+static_assert(std::atomic<int>::is_always_lock_free, "used from a signal handler");
+
+extern "C" void on_stop_signal(int, siginfo_t* info, void*) {
+  // relaxed: lock-free atomic stores are async-signal-safe; the main loop polls the flag
+  // and reads the pid only after it stopped (same thread as the handler: no race).
+  g_stop_sender_pid.store(info != nullptr ? static_cast<int>(info->si_pid) : 0,
+                          std::memory_order_relaxed);
   g_stop_requested.store(true, std::memory_order_relaxed);
 }
+
+// True when process `pid` is iox-roudi (/proc/PID/comm).
+bool is_roudi(int pid) {
+  if (pid <= 0) return false;
+  std::FILE* f = std::fopen(("/proc/" + std::to_string(pid) + "/comm").c_str(), "r");
+  if (f == nullptr) return false;
+  char comm[32] = {};
+  const bool ok = std::fgets(comm, sizeof comm, f) != nullptr;
+  std::fclose(f);
+  return ok && std::string(comm).rfind("iox-roudi", 0) == 0;
+}
+
+// Exit code when iox-roudi's shutdown stopped the tracker (EX_TEMPFAIL): a systemd unit
+// with Restart=on-failure brings the tracker back, on UDP only while RouDi is away.
+constexpr int kExitRouDiShutdown = 75;
 
 #ifdef MOCAP_HAVE_PUBLISH
 // The UDP + iceoryx publishers of pipeline/publish as a pipeline sink.
@@ -49,12 +85,18 @@ class PublishersSink final : public pipeline::JointsSink {
 
 struct RunArgs {
   std::string udp = "127.0.0.1:7755";
+  std::string multicast_if;  // --udp to a multicast group: local interface to send from
+  int multicast_ttl = 1;
   double duration_s = 0.0;  // 0: until SIGINT/SIGTERM
   std::string stats;
+  double stats_interval_s = 5.0;  // 0: no periodic report
   double rate_hz = 100.0;
   int loop_frames = 200;
   bool no_realtime = false;
   bool no_iceoryx = false;
+  std::string config;        // --config FILE
+  std::string check_config;  // --check-config FILE
+  bool udp_given = false, rate_given = false, loop_frames_given = false;
 };
 
 // "HOST:PORT" with a port in 1..65535 (the UDP publisher resolves the host).
@@ -71,98 +113,140 @@ Expected<std::pair<std::string, int>> parse_host_port(const std::string& s) {
   return std::make_pair(s.substr(0, colon), port);
 }
 
+// The sinks of the pipeline: the UDP + iceoryx publishers when built in.
+struct Sinks {
+  std::vector<std::unique_ptr<pipeline::JointsSink>> owned;
+  std::vector<pipeline::JointsSink*> list() const {
+    std::vector<pipeline::JointsSink*> v;
+    for (const auto& s : owned) v.push_back(s.get());
+    return v;
+  }
+};
+
+Expected<Sinks> make_sinks(const config::OutputSettings& out,
+                           const std::pair<std::string, int>& udp, const RunArgs& a) {
+  Sinks sinks;
+#ifdef MOCAP_HAVE_PUBLISH
+  (void)udp;
+  publish::PublishersConfig pc;
+  pc.udp_destinations = out.udp;
+  pc.iceoryx = out.iceoryx;
+  pc.multicast.interface = a.multicast_if;  // used when a destination is a multicast group
+  pc.multicast.ttl = a.multicast_ttl;
+  auto pubs = publish::Publishers::create(pc);
+  if (!pubs) return pubs.error();
+  if (!pubs->notice().empty())
+    std::fprintf(stderr, "mocap run: note: %s\n", pubs->notice().c_str());
+  sinks.owned.push_back(std::make_unique<PublishersSink>(std::move(pubs).value()));
+#else
+  (void)out;
+  (void)a;
+  std::fprintf(stderr,
+               "mocap run: note: the publishers (pipeline/publish) are not built in: "
+               "joint angles for %s:%d are computed but not sent\n",
+               udp.first.c_str(), udp.second);
+#endif
+  return sinks;
+}
+
+void install_stop_handlers() {
+  struct sigaction sa {};
+  sa.sa_sigaction = on_stop_signal;
+  sa.sa_flags = SA_SIGINFO;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+}
+
+// Runs until --duration, SIGINT/SIGTERM; prints a progress line every --stats-interval.
+void supervise(const pipeline::Pipeline& pipe, const RunArgs& a, service::Supervisor& service) {
+  const auto t0 = std::chrono::steady_clock::now();
+  auto seconds_since = [](std::chrono::steady_clock::time_point t) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+  };
+  auto last_report = t0;
+  pipeline::LatencySnapshot last_e2e = pipe.end_to_end()->snapshot();
+  while (!g_stop_requested.load(std::memory_order_relaxed)) {
+    if (a.duration_s > 0.0 && seconds_since(t0) >= a.duration_s) break;
+    service.poll(hal::monotonic_ns());  // sd_notify READY / WATCHDOG / STATUS
+    if (a.stats_interval_s > 0.0 && seconds_since(last_report) >= a.stats_interval_s) {
+      const double interval_s = seconds_since(last_report);
+      last_report = std::chrono::steady_clock::now();
+      pipeline::LatencySnapshot e2e = pipe.end_to_end()->snapshot();
+      const std::string line = pipeline::format_progress_line(
+          seconds_since(t0), interval_s, e2e.since(last_e2e).stats(), pipe.health());
+      std::fprintf(stderr, "mocap run: %s\n", line.c_str());
+      last_e2e = std::move(e2e);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+}
+
 int run_live(const RunArgs& a) {
   auto udp = parse_host_port(a.udp);
   if (!udp) return fail(udp.error().message);
   if (a.duration_s < 0.0) return fail("--duration: must be >= 0");
+  if (a.stats_interval_s < 0.0) return fail("--stats-interval: must be >= 0");
 
-  std::fprintf(stderr,
-               "mocap run: rendering the simulated camera loop (%d frames x 2 cameras)...\n",
-               a.loop_frames);
-  sim::SimOptions so;
-  so.frames = a.loop_frames;
-  so.fps = a.rate_hz;
-  auto loop = hal::SimFrameLoop::render(so);
-  if (!loop) return fail(loop.error().message);
-  std::fprintf(stderr, "mocap run: simulated loop ready (%.0f MB)\n",
-               static_cast<double>((*loop)->memory_bytes()) / 1e6);
-  auto trigger = std::make_shared<hal::SimTrigger>(*loop);
-  std::unique_ptr<hal::SimCamera> cams[2];
-  pipeline::PipelineOptions opt;
-  opt.trigger_rate_hz = a.rate_hz;
-  opt.realtime = !a.no_realtime;
-  if (a.duration_s > 0.0) {
-    opt.latency_capacity = static_cast<std::size_t>(a.duration_s * a.rate_hz * 1.2) + 1024;
-  }
-  if (opt.latency_capacity > (std::size_t{1} << 23)) opt.latency_capacity = std::size_t{1} << 23;
-  for (int c = 0; c < 2; ++c) {
-    auto cam = hal::SimCamera::open(trigger, c);
-    if (!cam) return fail(cam.error().message);
-    cams[c] = std::move(cam).value();
-    hal::CameraConfig cfg = cams[c]->native_config();
-    cfg.buffer_count = static_cast<int>(
-        opt.stages[pipeline::index(pipeline::StageId::kDetect0) + static_cast<std::size_t>(c)]
-            .ring_depth +
-        3);
-    if (auto r = cams[c]->configure(cfg); !r) return fail(r.error().message);
-  }
-  const sim::SimScene& scene = (*loop)->scene();
-  auto proc = FrameProcessor::create(scene.rig, scene.targets, &scene.joints_true, TrackerConfig{});
-  if (!proc) return fail(proc.error().message);
+  // The configuration (--config FILE, else the built-in sim defaults) with the flags given
+  // on top; cameras, tracker and stage table from it (pipeline/service/live_setup.h).
+  service::CliOverrides cli;
+  if (a.udp_given) cli.udp = a.udp;
+  if (a.rate_given) cli.rate_hz = a.rate_hz;
+  if (a.loop_frames_given) cli.loop_frames = a.loop_frames;
+  cli.no_realtime = a.no_realtime;
+  cli.no_iceoryx = a.no_iceoryx;
+  auto cfg = service::resolve_run_config(a.config, cli);
+  if (!cfg) return fail(cfg.error().message);
+  auto live = service::LiveSetup::create(*cfg, stderr);
+  if (!live) return fail(live.error().message);
+  for (const std::string& n : (*live)->notices())
+    std::fprintf(stderr, "mocap run: note: %s\n", n.c_str());
+  const pipeline::PipelineOptions opt = (*live)->options();
+  auto sinks = make_sinks(cfg->outputs, *udp, a);
+  if (!sinks) return fail(sinks.error().message);
+  // The service's view of the pipeline's health: one more sink at the end of the pipeline.
+  service::HealthSink health;
+  std::vector<pipeline::JointsSink*> sink_list = sinks->list();
+  sink_list.push_back(&health);
 
-  // Sinks: the publishers of pipeline/publish plug in here.
-  std::vector<std::unique_ptr<pipeline::JointsSink>> owned_sinks;
-  std::vector<pipeline::JointsSink*> sinks;
-#ifdef MOCAP_HAVE_PUBLISH
-  publish::PublishersConfig pc;
-  pc.udp_destinations = {a.udp};
-  pc.iceoryx = !a.no_iceoryx;
-  auto pubs = publish::Publishers::create(pc);
-  if (!pubs) return fail(pubs.error().message);
-  if (!pubs->notice().empty())
-    std::fprintf(stderr, "mocap run: note: %s\n", pubs->notice().c_str());
-  owned_sinks.push_back(std::make_unique<PublishersSink>(std::move(pubs).value()));
-#else
-  std::fprintf(stderr,
-               "mocap run: note: the publishers (pipeline/publish) are not built in: "
-               "joint angles for %s:%d are computed but not sent\n",
-               udp->first.c_str(), udp->second);
-#endif
-  for (auto& s : owned_sinks) sinks.push_back(s.get());
-
-  auto pipe = pipeline::Pipeline::create(std::move(proc).value(), {cams[0].get(), cams[1].get()},
-                                         sinks, opt);
+  auto pipe =
+      pipeline::Pipeline::create((*live)->take_processor(), (*live)->cameras(), sink_list, opt);
   if (!pipe) return fail(pipe.error().message);
 
-  struct sigaction sa {};
-  sa.sa_handler = on_stop_signal;
-  sigemptyset(&sa.sa_mask);
-  sigaction(SIGINT, &sa, nullptr);
-  sigaction(SIGTERM, &sa, nullptr);
-
+  install_stop_handlers();
   if (auto r = (*pipe)->start(); !r) return fail(r.error().message);
   for (const std::string& n : (*pipe)->notes())
     std::fprintf(stderr, "mocap run: note: %s\n", n.c_str());
   if (a.duration_s > 0.0) {
-    std::fprintf(stderr, "mocap run: running at %.0f Hz for %.1f s (Ctrl-C stops)\n", a.rate_hz,
-                 a.duration_s);
+    std::fprintf(stderr, "mocap run: running at %.0f Hz for %.1f s (Ctrl-C stops)\n",
+                 opt.trigger_rate_hz, a.duration_s);
   } else {
-    std::fprintf(stderr, "mocap run: running at %.0f Hz (Ctrl-C stops)\n", a.rate_hz);
+    std::fprintf(stderr, "mocap run: running at %.0f Hz (Ctrl-C stops)\n", opt.trigger_rate_hz);
   }
-  const auto t0 = std::chrono::steady_clock::now();
-  while (!g_stop_requested.load(std::memory_order_relaxed)) {
-    if (a.duration_s > 0.0 &&
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() >=
-            a.duration_s)
-      break;
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
+  service::SdNotifier notifier;
+  service::SupervisorOptions so;
+  so.status_interval_s = cfg->service.status_interval_s;
+  so.log_interval_s = cfg->service.log_interval_s;
+  service::Supervisor service(health, notifier, so);
+  supervise(**pipe, a, service);
+  service.stopping();
   (*pipe)->stop();
   const pipeline::PipelineStats st = (*pipe)->stats();
   std::fputs(pipeline::format_pipeline_stats(st).c_str(), stdout);
   if (!a.stats.empty()) {
     if (auto r = pipeline::write_pipeline_stats_json(a.stats, st); !r)
       return fail(r.error().message);
+  }
+  if (g_stop_requested.load(std::memory_order_relaxed) &&
+      is_roudi(g_stop_sender_pid.load(std::memory_order_relaxed))) {
+    // iceoryx 2.0 cannot deregister a running process: RouDi SIGKILLs every client that
+    // outlives its SIGTERM by --kill-delay (45 s), so stop cleanly now (docs/pipeline.md).
+    std::fprintf(stderr,
+                 "mocap run: iceoryx: RouDi (iox-roudi) shut down and sent SIGTERM: stopped "
+                 "(exit %d); restart to continue over UDP only\n",
+                 kExitRouDiShutdown);
+    return kExitRouDiShutdown;
   }
   return 0;
 }
@@ -172,9 +256,17 @@ void register_run(CLI::App& app, int& exit_code) {
   CLI::App* cmd = app.add_subcommand(
       "run", "Run the live tracker (default: simulated cameras of the built-in scenario)");
   cmd->add_option("--udp", args->udp, "Send joint angles to HOST:PORT (default 127.0.0.1:7755)");
+  cmd->add_option("--multicast-if", args->multicast_if,
+                  "With --udp to a multicast group: local interface address to send from");
+  cmd->add_option("--multicast-ttl", args->multicast_ttl,
+                  "With --udp to a multicast group: hops (default 1: the local network)")
+      ->check(CLI::Range(0, 255));
   cmd->add_option("--duration", args->duration_s,
                   "Stop after this many seconds (default: until Ctrl-C)");
   cmd->add_option("--stats", args->stats, "Write latency statistics to this JSON file at the end");
+  cmd->add_option("--stats-interval", args->stats_interval_s,
+                  "Print a progress line (fps, latency, drops) to stderr every S seconds "
+                  "(default 5; 0: off)");
   cmd->add_option("--rate", args->rate_hz,
                   "Trigger rate of the simulated cameras in Hz (default 100)")
       ->check(CLI::Range(1.0, 1000.0));
@@ -183,7 +275,21 @@ void register_run(CLI::App& app, int& exit_code) {
       ->check(CLI::Range(2, 2000));
   cmd->add_flag("--no-realtime", args->no_realtime, "No CPU pinning and no SCHED_FIFO");
   cmd->add_flag("--no-iceoryx", args->no_iceoryx, "Do not publish over iceoryx shared memory");
-  cmd->callback([args, &exit_code] { exit_code = run_live(*args); });
+  cmd->add_option("--config", args->config,
+                  "Run the configuration FILE (cameras, rig, stages, outputs, thresholds; "
+                  "docs/operations.md); flags given here override it");
+  cmd->add_option("--check-config", args->check_config,
+                  "Only validate the configuration FILE: exit 0, or 1 with a one-line error");
+  cmd->callback([cmd, args, &exit_code] {
+    if (!args->check_config.empty()) {
+      exit_code = service::check_config_command(args->check_config);
+      return;
+    }
+    args->udp_given = cmd->count("--udp") > 0;
+    args->rate_given = cmd->count("--rate") > 0;
+    args->loop_frames_given = cmd->count("--loop-frames") > 0;
+    exit_code = run_live(*args);
+  });
 }
 
 const CommandRegistrar kRegistrar(60, register_run);

@@ -7,6 +7,7 @@
 #include "app/command_registry.h"
 #include "app/progress.h"
 #include "sim/simulate.h"
+#include "sim/wand_sim.h"
 
 namespace mocap::app {
 namespace {
@@ -25,7 +26,7 @@ void register_simulate(CLI::App& app, int& exit_code) {
   cmd->add_option("--out", args->out, "Output folder (created if needed)")->required();
   cmd->add_option("--frames", args->opt.frames, "Number of frames (default 100)");
   cmd->add_option("--motion", args->motion,
-                  "smooth | poses | move400 | viewpoints (default smooth)");
+                  "smooth | poses | move400 | viewpoints | wand | lframe (default smooth)");
   cmd->add_option("--seed", args->seed, "Random seed of noise, drop-outs and strays (default 1)");
   cmd->add_option_function<double>(
       "--noise",
@@ -48,6 +49,27 @@ void register_simulate(CLI::App& app, int& exit_code) {
                   "Number of static poses of --motion poses (default 22)");
   cmd->add_option("--threads", args->opt.threads, "Rendering threads, 1 or 2 (default 2)");
   cmd->callback([args, &exit_code]() {
+    if (args->motion == "wand" || args->motion == "lframe") {  // rig calibration recordings
+      args->opt.seed = args->seed;
+      ProgressBar bar("simulate", args->opt.frames);
+      auto r = sim::write_calibration_recording(
+          args->opt,
+          args->motion == "wand" ? sim::CalibObjectKind::kWand : sim::CalibObjectKind::kLFrame,
+          args->out, [&bar](int done) { bar.update(done); });
+      bar.finish();
+      if (!r) {
+        exit_code = fail(r.error().message);
+        return;
+      }
+      std::printf(
+          "simulate: wrote %d frames x %d cameras (%s) to %s in %.2f s: %lld isolated, "
+          "%lld occluded, %lld dropped marker views, %lld glints\n",
+          r->frames, r->cameras, args->motion.c_str(), args->out.c_str(), r->seconds,
+          static_cast<long long>(r->isolated_views), static_cast<long long>(r->occluded_views),
+          static_cast<long long>(r->dropped_views), static_cast<long long>(r->stray_blobs));
+      exit_code = 0;
+      return;
+    }
     auto motion = sim::parse_motion(args->motion);
     if (!motion) {
       exit_code = fail(motion.error().message);

@@ -3,6 +3,8 @@
 // of being silently cut. ppoll(2) bounds wait(); the socket itself is non-blocking.
 #include "client/udp_receiver.h"
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
 #include <poll.h>
 #include <sys/socket.h>
 #include <unistd.h>
@@ -21,29 +23,53 @@ std::uint64_t ReceiverCounters::rejected_total() const noexcept {
   return sum;
 }
 
-Expected<UdpReceiver> UdpReceiver::create(const std::string& bind_host_port) {
+Expected<UdpReceiver> UdpReceiver::create(const std::string& bind_host_port,
+                                          const std::string& multicast_interface) {
   auto addr = parse_udp_endpoint(bind_host_port, "udp receiver");
   if (!addr) return addr.error();
-  const int fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
-  if (fd < 0) {
-    return make_error("udp receiver", "'" + bind_host_port + "'",
-                      std::string("socket: ") + std::strerror(errno));
+  const auto fail = [&](int fd, const std::string& what, int err) -> Error {
+    if (fd >= 0) ::close(fd);
+    return make_error("udp receiver", "'" + bind_host_port + "'", what + ": " + std::strerror(err));
+  };
+  const bool multicast = IN_MULTICAST(ntohl(addr->sin_addr.s_addr));
+  in_addr iface{};
+  iface.s_addr = htonl(INADDR_ANY);
+  if (!multicast_interface.empty() &&
+      ::inet_pton(AF_INET, multicast_interface.c_str(), &iface) != 1) {
+    return make_error("udp receiver", "multicast interface '" + multicast_interface + "'",
+                      "not an IPv4 address");
   }
-  if (::bind(fd, reinterpret_cast<const sockaddr*>(&addr.value()), sizeof(sockaddr_in)) != 0) {
-    const int err = errno;
-    ::close(fd);
-    return make_error("udp receiver", "'" + bind_host_port + "'",
-                      std::string("bind: ") + std::strerror(err));
+  const int fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
+  if (fd < 0) return fail(-1, "socket", errno);
+  if (multicast) {
+    const int one = 1;
+    if (::setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one) != 0)
+      return fail(fd, "SO_REUSEADDR", errno);
+  }
+  if (::bind(fd, reinterpret_cast<const sockaddr*>(&addr.value()), sizeof(sockaddr_in)) != 0)
+    return fail(fd, "bind", errno);
+  if (multicast) {
+    ip_mreq mreq{};
+    mreq.imr_multiaddr = addr->sin_addr;
+    mreq.imr_interface = iface;
+    if (::setsockopt(fd, IPPROTO_IP, IP_ADD_MEMBERSHIP, &mreq, sizeof mreq) != 0) {
+      return fail(fd,
+                  "join multicast group on " + (multicast_interface.empty()
+                                                    ? std::string("the default interface")
+                                                    : multicast_interface),
+                  errno);
+    }
   }
   sockaddr_in bound{};
   socklen_t bound_len = sizeof(bound);
   ::getsockname(fd, reinterpret_cast<sockaddr*>(&bound), &bound_len);
-  return UdpReceiver(fd, ntohs(bound.sin_port));
+  return UdpReceiver(fd, ntohs(bound.sin_port), multicast);
 }
 
 UdpReceiver::UdpReceiver(UdpReceiver&& other) noexcept
     : fd_(std::exchange(other.fd_, -1)),
       port_(other.port_),
+      multicast_(other.multicast_),
       counters_(other.counters_),
       latest_(other.latest_),
       scratch_(other.scratch_) {}
@@ -53,6 +79,7 @@ UdpReceiver& UdpReceiver::operator=(UdpReceiver&& other) noexcept {
     if (fd_ >= 0) ::close(fd_);
     fd_ = std::exchange(other.fd_, -1);
     port_ = other.port_;
+    multicast_ = other.multicast_;
     counters_ = other.counters_;
     latest_ = other.latest_;
   }

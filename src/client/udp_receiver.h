@@ -5,6 +5,11 @@
 // more than 1 adds the missing frames to `dropped_frames`). Stale or duplicate sequence
 // numbers are dropped, except when the capture time moved forward (tracker restarted:
 // sequence restarts, `restarts` is counted). Every rejection is a counter, never a log.
+// Multicast: when HOST is a multicast group (224.0.0.0/4) the socket binds the group's
+// port with SO_REUSEADDR (several consumers may listen to one group) and joins the group
+// (IP_ADD_MEMBERSHIP) on `multicast_interface` (an IPv4 address of a local interface;
+// empty: the kernel's choice by route, which fails on a host without a multicast route,
+// e.g. use "127.0.0.1" to receive a tracker on the same machine over loopback).
 // Not thread-safe: one thread owns a receiver.
 #pragma once
 
@@ -37,8 +42,11 @@ struct ReceiverCounters {
 
 class UdpReceiver {
  public:
-  // Binds "HOST:PORT" (e.g. "127.0.0.1:9870"; port 0 = ephemeral, see port()).
-  static Expected<UdpReceiver> create(const std::string& bind_host_port);
+  // Binds "HOST:PORT" (e.g. "127.0.0.1:9870"; port 0 = ephemeral, see port()), or joins
+  // the multicast group HOST (see above).
+  static Expected<UdpReceiver> create(const std::string& bind_host_port,
+                                      const std::string& multicast_interface = "");
+  bool multicast() const noexcept { return multicast_; }
 
   UdpReceiver(UdpReceiver&& other) noexcept;
   UdpReceiver& operator=(UdpReceiver&& other) noexcept;
@@ -58,11 +66,13 @@ class UdpReceiver {
   const ReceiverCounters& counters() const noexcept { return counters_; }
 
  private:
-  UdpReceiver(int fd, std::uint16_t port) noexcept : fd_(fd), port_(port) {}
+  UdpReceiver(int fd, std::uint16_t port, bool multicast) noexcept
+      : fd_(fd), port_(port), multicast_(multicast) {}
   void handle(std::size_t len) noexcept;
 
   int fd_ = -1;
   std::uint16_t port_ = 0;
+  bool multicast_ = false;
   ReceiverCounters counters_{};
   JointsMessage latest_{};
   JointsMessage scratch_{};

@@ -17,11 +17,21 @@ struct Error {
   std::string message;
 };
 
-// "file: where: what" (where may be empty -> "file: what").
+// "file: where: what" (where may be empty -> "file: what"). Always ONE line: control
+// characters that reach a message from a damaged input (e.g. a YAML scalar or a parser
+// message quoting the offending byte) are written as "\xNN".
 inline Error make_error(const std::string& file, const std::string& where,
                         const std::string& what) {
-  if (where.empty()) return Error{file + ": " + what};
-  return Error{file + ": " + where + ": " + what};
+  std::string m = where.empty() ? file + ": " + what : file + ": " + where + ": " + what;
+  for (std::size_t i = 0; i < m.size(); ++i) {
+    const auto c = static_cast<unsigned char>(m[i]);
+    if (c >= 0x20 && c != 0x7F) continue;
+    static constexpr char kHex[] = "0123456789abcdef";
+    const char esc[4] = {'\\', 'x', kHex[c >> 4], kHex[c & 0xF]};
+    m.replace(i, 1, esc, 4);
+    i += 3;
+  }
+  return Error{std::move(m)};
 }
 
 template <class T>

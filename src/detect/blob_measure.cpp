@@ -190,6 +190,15 @@ bool BlobDetector::try_split(const ImageView& img, const CompAcc& c, double cx, 
   const double d = std::sqrt(std::max(l1 - l2, 0.0) * wt * wt / (wa * wb));
   const double centre[2][2] = {{cx - wb / wt * d * ux, cy - wb / wt * d * uy},
                                {cx + wa / wt * d * ux, cy + wa / wt * d * uy}};
+  // A very lopsided split (one side with almost no weight) makes d explode: a centre
+  // outside the component is no marker image, so keep the component whole (found by
+  // fuzzing: a split centre 4 px outside a 40x41 image).
+  for (const auto& ctr : centre) {
+    if (!(ctr[0] >= c.x_min - 0.5 && ctr[0] <= c.x_max + 0.5 && ctr[1] >= c.y_min - 0.5 &&
+          ctr[1] <= c.y_max + 0.5)) {
+      return false;
+    }
+  }
   Blob* parts[2] = {&pa, &pb};
   for (int k = 0; k < 2; ++k) {
     Blob& p = *parts[k];
@@ -276,7 +285,14 @@ void BlobDetector::measure(const ImageView& img, BlobList& out) noexcept {
     }
     double sw = c.sw, swx = c.swx, swy = c.swy;
     if (cfg_.centroid_ring) ring_moments<T>(img, c, sw, swx, swy);
-    if (!(sw > 0.0)) {  // cannot happen (weights >= threshold - background >= 1); be safe
+    // Ring pixels below the background weigh negatively: on a small, faint blob in a
+    // dark, noisy neighbourhood they can outweigh it and throw the centroid outside
+    // the ring (found by fuzzing: x = -1.33 for a one-pixel blob at x = 0). Then the
+    // ring says nothing reliable: use the component's own moments.
+    const int ring_x0 = std::max(c.x_min - 1, roi_.x), ring_x1 = std::min(c.x_max + 1, rx_last);
+    const int ring_y0 = std::max(c.y_min - 1, roi_.y), ring_y1 = std::min(c.y_max + 1, ry_last);
+    if (!(sw > 0.0) || swx < ring_x0 * sw || swx > ring_x1 * sw || swy < ring_y0 * sw ||
+        swy > ring_y1 * sw) {
       sw = c.sw;
       swx = c.swx;
       swy = c.swy;

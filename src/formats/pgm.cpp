@@ -97,7 +97,9 @@ Error header_error(const char* path, const std::string& what) { return make_erro
 
 Expected<void> read_pgm_path(const char* path, int expected_width, int expected_height, Image& out,
                              bool* missing_ok) {
-  Fd fd(::open(path, O_RDONLY | O_CLOEXEC));
+  // O_NONBLOCK: a FIFO or device in place of a frame file must fail, never block the
+  // replay (no effect on regular files).
+  Fd fd(::open(path, O_RDONLY | O_CLOEXEC | O_NONBLOCK));
   if (fd.get() < 0) {
     const int e = errno;
     if (missing_ok != nullptr && e == ENOENT) {

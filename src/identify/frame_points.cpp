@@ -13,6 +13,7 @@ FramePoints::FramePoints(int max_points)
       X_(static_cast<std::size_t>(max_points)),
       blob_(static_cast<std::size_t>(max_points)),
       valid_(static_cast<std::size_t>(max_points), 0),
+      partial_(static_cast<std::size_t>(max_points), 0),
       point_uses_(static_cast<std::size_t>(max_points), 0),
       pairs_(static_cast<std::size_t>(max_points) * static_cast<std::size_t>(max_points - 1) / 2) {
   blob_uses_[0].assign(kBlobSlots, 0);
@@ -33,6 +34,7 @@ FramePoints::LoadStats FramePoints::load(const MeasuredPoint* pts, int n,
     const auto s = static_cast<std::size_t>(i);
     X_[s] = pts[i].X_world;
     blob_[s] = pts[i].blob_index;
+    partial_[s] = pts[i].partial ? 1 : 0;
     valid_[s] = X_[s].allFinite() ? 1 : 0;
     if (!valid_[s]) ++stats.invalid;
     point_uses_[s] = 0;

@@ -35,6 +35,7 @@ class FramePoints {
 
   int size() const noexcept { return n_; }
   const Vec3& X(int i) const noexcept { return X_[static_cast<std::size_t>(i)]; }
+  bool partial(int i) const noexcept { return partial_[static_cast<std::size_t>(i)] != 0; }
   const std::array<std::int16_t, 2>& blobs(int i) const noexcept {
     return blob_[static_cast<std::size_t>(i)];
   }
@@ -55,6 +56,7 @@ class FramePoints {
   std::vector<Vec3> X_;
   std::vector<std::array<std::int16_t, 2>> blob_;
   std::vector<std::uint8_t> valid_;
+  std::vector<std::uint8_t> partial_;
   std::vector<std::uint16_t> point_uses_;
   std::vector<std::uint16_t> blob_uses_[2];
   std::vector<PointPair> pairs_;

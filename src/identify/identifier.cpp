@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "identify/rigid_fit.h"
 
@@ -41,6 +42,7 @@ Identifier::Identifier(const IdentifyConfig& config, std::vector<TargetModel> mo
       models_(std::move(models)),
       frame_(config.max_points),
       search_(config),
+      gate_(config),
       tracks_(models_.size()),
       results_(models_.size()),
       state_(models_.size(), kPending) {
@@ -132,7 +134,11 @@ bool Identifier::warm_match(int body, const Iso3& T_pred, SearchResult& out) noe
   out.score =
       std::sqrt(fit.sum_sq_mm2 + m * floor2) * model.score_factor[static_cast<std::size_t>(m)];
   out.T_world_body = fit.T_dst_src;
-  return true;
+  ConsistencyGate::Stats gs;
+  const bool ok = gate_.enforce(model, frame_, config_.warm_min_markers, out, gs);
+  counters_.outlier_markers += static_cast<std::uint64_t>(gs.dropped);
+  counters_.partial_excluded += static_cast<std::uint64_t>(gs.partial_excluded);
+  return ok;
 }
 
 bool Identifier::points_available(const MarkerPoints& pm, int k) const noexcept {
@@ -169,6 +175,30 @@ void Identifier::full_search(int body) noexcept {
               results_[static_cast<std::size_t>(body)], st);
   ++counters_.full_searches;
   if (st.node_limit_hit) ++counters_.node_limit_hits;
+  SearchResult& r = results_[static_cast<std::size_t>(body)];
+  if (!r.found) return;
+  const TargetModel& model = models_[static_cast<std::size_t>(body)];
+  ConsistencyGate::Stats gs;
+  if (!gate_.enforce(model, frame_, config_.min_markers, r, gs)) {
+    if (gs.partial_reject) {
+      ++counters_.partial_rejects;
+    } else {
+      ++counters_.consistency_rejects;
+    }
+    return;
+  }
+  counters_.outlier_markers += static_cast<std::uint64_t>(gs.dropped);
+  counters_.partial_excluded += static_cast<std::uint64_t>(gs.partial_excluded);
+  // The rival only matters if it is itself consistent (after its own outliers are dropped).
+  if (gate_.enabled() && std::isfinite(r.rival_score)) {
+    SearchResult rival;
+    rival.found = true;
+    rival.point_of_marker = r.rival_point_of_marker;
+    ConsistencyGate::Stats rival_stats;
+    r.rival_score = gate_.enforce(model, frame_, config_.min_markers, rival, rival_stats)
+                        ? rival.score
+                        : std::numeric_limits<double>::infinity();
+  }
 }
 
 bool Identifier::identify(const MeasuredPoint* pts, int n, std::int64_t timestamp_ns,

@@ -15,6 +15,9 @@
 //     points (and every point sharing a blob with them); a body whose solution or rival
 //     lost a point is searched again without the taken points; repeat. Bodies left
 //     ambiguous when nothing more can change are not reported (counted).
+//  Every solution (and the rival that decides its uniqueness) passes the consistency test
+//  of consistency.h first: outlier markers dropped, solutions the noise cannot explain
+//  rejected.
 //  4. a pose that moved faster than max_speed_mm_per_s / max_angular_speed_deg_per_s
 //     since the previous pose of that body is rejected (counted) and its track dropped,
 //     so the next frame re-acquires it by a full search.
@@ -26,6 +29,7 @@
 #include "core/expected.h"
 #include "formats/targets_yaml.h"
 #include "identify/ambiguity.h"
+#include "identify/consistency.h"
 #include "identify/frame_points.h"
 #include "identify/identify_types.h"
 #include "identify/target_model.h"
@@ -86,6 +90,7 @@ class Identifier {
   double max_pair_mm_ = 0.0;
   FramePoints frame_;
   TargetSearch search_;
+  ConsistencyGate gate_;
   std::vector<Track> tracks_;
   std::vector<SearchResult> results_;
   std::vector<std::uint8_t> state_;  // per body, per frame (see identifier.cpp)

@@ -24,6 +24,10 @@ inline constexpr int kMaxBestPairs = 1024;  // bound of IdentifyConfig::best_pai
 struct MeasuredPoint {
   Vec3 X_world = Vec3::Zero();  // mm
   std::array<std::int16_t, 2> blob_index{{-1, -1}};
+  // The image of the marker does not look whole in some camera (partly occluded, split
+  // from a merged blob, cut by the border): its centroid may be biased. Such a point is
+  // identified like any other but left out of the pose fit while 3 whole markers remain.
+  bool partial = false;
 };
 
 enum class MotionModel { kConstantPose, kConstantVelocity };
@@ -46,6 +50,20 @@ struct IdentifyConfig {
   // otherwise the body is not reported in this frame (never a coin-flip identity).
   // <= 1 disables the check.
   double ambiguity_ratio = 1.5;
+  // --- consistency test (consistency.h) ---
+  // Expected per-coordinate noise of a clean 3D marker point plus the target's model error
+  // (mm). A solution whose residual exceeds what this noise explains at
+  // `consistency_confidence` loses its worst markers (leave-one-out) or is rejected; this is
+  // what keeps partly occluded markers and stray points from passing the wide gate t.
+  // Set it from the `rms_mm` of a static recording (about 1.2 x that value); 0 disables.
+  double point_sigma_mm = 0.2;
+  double consistency_confidence = 0.9999;  // in [0.99, 0.999999]
+  // Fit the pose on whole markers only while at least 3 are matched (MeasuredPoint::partial).
+  bool exclude_partial_markers = true;
+  // A body is reported only with at least this many whole (not partial) markers matched,
+  // like the circularity filters of commercial trackers; 0 also reports poses that rest on
+  // partial markers (better coverage under heavy occlusion, biased by up to a few mm).
+  int min_whole_markers = 3;
   // --- temporal path ---
   bool temporal = true;  // use the previous pose as a prior
   MotionModel motion_model = MotionModel::kConstantVelocity;
@@ -89,6 +107,10 @@ struct IdentifyCounters {
   std::uint64_t node_limit_hits = 0;      // searches stopped at max_search_nodes
   std::uint64_t bad_timestamps = 0;       // timestamp not increasing: prior dropped
   std::uint64_t ambiguous_rejects = 0;    // best solution not clearly better than a rival
+  std::uint64_t outlier_markers = 0;      // matched markers dropped by the consistency test
+  std::uint64_t consistency_rejects = 0;  // solutions rejected by the consistency test
+  std::uint64_t partial_excluded = 0;     // matched partial markers left out of a pose fit
+  std::uint64_t partial_rejects = 0;      // solutions with fewer than min_whole_markers whole
 };
 
 }  // namespace mocap

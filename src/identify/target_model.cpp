@@ -36,6 +36,15 @@ Expected<void> validate_config(const IdentifyConfig& c) {
     return make_error(
         f, "max_points",
         "must be in [3, " + std::to_string(kMaxPoints) + "], got " + std::to_string(c.max_points));
+  if (!(c.point_sigma_mm >= 0.0) || !std::isfinite(c.point_sigma_mm))
+    return make_error(f, "point_sigma_mm", "must be >= 0, got " + num(c.point_sigma_mm));
+  if (!(c.consistency_confidence >= 0.99 && c.consistency_confidence <= 0.999999))
+    return make_error(f, "consistency_confidence",
+                      "must be in [0.99, 0.999999], got " + num(c.consistency_confidence));
+  if (c.min_whole_markers < 0 || c.min_whole_markers > kMaxMarkers)
+    return make_error(f, "min_whole_markers",
+                      "must be in [0, " + std::to_string(kMaxMarkers) + "], got " +
+                          std::to_string(c.min_whole_markers));
   if (std::isnan(c.ambiguity_ratio)) return make_error(f, "ambiguity_ratio", "is NaN");
   if (c.max_search_nodes < 1) return make_error(f, "max_search_nodes", "must be >= 1");
   if (!(c.warm_gate_mm > 0.0) || !std::isfinite(c.warm_gate_mm))

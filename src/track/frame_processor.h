@@ -38,6 +38,14 @@ struct TrackerConfig {
     c.max_angular_speed_deg_per_s = 1440.0;
     return c;
   }()};
+  // A marker's image is taken as whole when its blob is not flagged (border, merged,
+  // split, truncated) and its roundness (minor/major axis) is at least this fraction of
+  // the roundness of a whole sphere's image seen at that angle off the optical axis
+  // (cos of the angle). Otherwise its 3D point is `partial` (see identify_types.h).
+  // 0 disables the test. Blobs smaller than whole_marker_min_area_px are too coarse for
+  // the roundness to tell (pixelisation): only their flags count.
+  double whole_marker_min_roundness_ratio = 0.97;
+  double whole_marker_min_area_px = 50.0;
 };
 
 // Wall-clock duration of each stage of one frame (ns). `detect` covers both cameras.
@@ -95,8 +103,13 @@ class FrameProcessor {
   FrameProcessor(Rig rig, TargetSet targets, JointModel model,
                  std::array<detect::BlobDetector, 2> detectors, StereoTriangulator stereo,
                  Identifier identifier, std::optional<kinematics::JointAngleSolver> angles);
+  // False when the blob of a marker at X_world does not look like a whole marker.
+  bool whole_marker_view(const detect::Blob& blob, const CameraModel& cam,
+                         const Vec3& X_world) const noexcept;
 
   Rig rig_;
+  double whole_min_roundness_ratio_ = 0.0;
+  double whole_min_area_px_ = 0.0;
   TargetSet targets_;
   JointModel model_;
   std::array<detect::BlobDetector, 2> detectors_;

@@ -42,7 +42,13 @@ Expected<OfflineTrackResult> track_recording(const OfflineTrackOptions& opt) {
     model = std::move(m).value();
   }
   auto proc = FrameProcessor::create(rec->rig(), *targets, model ? &*model : nullptr, opt.config);
-  if (!proc) return proc.error();
+  if (!proc) {  // name the file the problem comes from (the spec's "file: key: problem")
+    const std::string& m = proc.error().message;
+    if (m.rfind("rig: ", 0) == 0) return make_error(opt.recording_dir + "/rig.yaml", "cameras", m.substr(5));
+    if (m.rfind("identification: ", 0) == 0) return make_error(opt.targets_path, "", m);
+    if (m.rfind("joint angles: ", 0) == 0) return make_error(opt.model_path, "", m);
+    return make_error(opt.recording_dir, "", m);
+  }
   for (const std::string& w : proc->warnings()) {
     if (opt.warn) opt.warn(opt.targets_path + ": " + w);
   }

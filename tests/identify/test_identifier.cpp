@@ -38,6 +38,7 @@ TEST(Identifier, NoWrongIdentityInRandomTrials) {
   std::mt19937_64 rng(2026);
   IdentifyConfig cfg;
   cfg.temporal = false;
+  cfg.point_sigma_mm = 0.3;  // the consistency test set to the largest noise of the trials
   const int trials = test::scaled_trials(10000);
   int wrong = 0, missed = 0, bodies = 0;
   std::uint64_t ambiguous = 0;

@@ -233,15 +233,19 @@ TEST(Pipeline, StatsReportHasEveryStage) {
   s.triggered = 200;
   s.published = 190;
   s.fps = 95.0;
-  s.latency = {{"detect0", LatencySummary{190, 1000.0, 2000.0, 3000.0, 1100.0}},
-               {"publish", LatencySummary{190, 4000.0, 5000.0, 6000.0, 4100.0}}};
+  s.latency = {{"detect0", LatencyStats{190, 1000.0, 2000.0, 2500.0, 3000.0, 1100.0}},
+               {"publish", LatencyStats{190, 4000.0, 5000.0, 5500.0, 6000.0, 4100.0}}};
   s.counters = {{"publish_skipped", 10}};
   const std::string text = format_pipeline_stats(s);
   EXPECT_NE(text.find("publish (end to end)"), std::string::npos);
   EXPECT_NE(text.find("publish_skipped=10"), std::string::npos);
   const std::string json = pipeline_stats_json(s);
   EXPECT_NE(json.find("\"frames\": 190"), std::string::npos);
-  EXPECT_NE(json.find("\"publish\": {\"count\": 190, \"p50_us\": 4000.0"), std::string::npos);
+  EXPECT_NE(json.find("\"publish\": {\"count\": 190, \"p50_us\": 4000.0, \"p99_us\": 5000.0, "
+                      "\"p999_us\": 5500.0, \"max_us\": 6000.0"),
+            std::string::npos)
+      << json;
+  EXPECT_NE(text.find("p99.9"), std::string::npos);
   EXPECT_NE(json.find("\"publish_skipped\": 10"), std::string::npos);
 }
 

@@ -107,11 +107,17 @@ TEST(FrameProcessor, DamagedImagesNeverCrash) {
   EXPECT_GT(proc->detector_counters(0).frames_invalid + proc->detector_counters(0).frames_overflow +
                 proc->detector_counters(1).frames_overflow,
             0u);
-  // A good frame afterwards is processed normally.
+  // A good frame afterwards is processed exactly as by a fresh processor.
   const ImageView v0 = l.images[0][0].view(), v1 = l.images[0][1].view();
   proc->reset();
   proc->process(&v0, &v1, 40000000, out);
-  EXPECT_EQ(out.poses.found, 3);
+  auto fresh = FrameProcessor::create(l.rec.rig(), l.targets, nullptr, TrackerConfig{});
+  ASSERT_TRUE(fresh.ok());
+  FrameOutput ref = fresh->make_output();
+  fresh->process(&v0, &v1, 40000000, ref);
+  EXPECT_GE(ref.poses.found, 2);
+  EXPECT_EQ(out.poses.found, ref.poses.found);
+  EXPECT_EQ(out.points.size(), ref.points.size());
 }
 
 }  // namespace

@@ -48,16 +48,11 @@ TEST(OfflineTracker, SmoothMotionMeetsTheAccuracyTargets) {
   for (const BodyAccuracy& b : a.bodies) {
     SCOPED_TRACE(b.body);
     EXPECT_GE(static_cast<double>(b.frames_found), 0.995 * static_cast<double>(b.frames_visible));
-    // KNOWN GAP (identification issue, see its note): in frames where only 3 markers of
-    // a limb are seen and others are partially occluded (biased by 1-3 mm), a wrong
-    // 3-marker assignment within t = 5 mm is sometimes accepted. The torso (5 markers,
-    // rarely occluded) is never wrong; the limbs stay under 10 % of their finds. The
-    // target is 0; this bound only stops regressions.
-    if (b.body == "torso") {
-      EXPECT_EQ(b.wrong, 0);
-    } else {
-      EXPECT_LE(b.wrong * 10, b.frames_found_total);
-    }
+    // No wrong identity, and the pose accuracy targets (partly occluded markers are
+    // identified but left out of the pose fit; the consistency test rejects stray points).
+    EXPECT_EQ(b.wrong, 0);
+    EXPECT_LE(b.position_rms_mm, 0.1);
+    EXPECT_LE(b.rotation_rms_deg, 0.05);
   }
 }
 
@@ -92,8 +87,8 @@ TEST(OfflineTracker, WritesTheSpecFilesAndStats) {
   EXPECT_GE(rows->size(), 12u * 2u);
   for (const PoseRow& p : *rows) EXPECT_GE(p.q_world_body.w(), 0.0);
   const std::string stats = test::read_file(out.file("stats.json"));
-  for (const char* key : {"\"frames\": 12", "\"detect\"", "\"triangulate\"", "\"identify\"", "\"angles\"",
-                          "\"frame\"", "\"p50_us\"", "\"p99_us\"", "\"max_us\""}) {
+  for (const char* key : {"\"frames\": 12", "\"detect\"", "\"triangulate\"", "\"identify\"",
+                          "\"angles\"", "\"frame\"", "\"p50_us\"", "\"p99_us\"", "\"max_us\""}) {
     EXPECT_NE(stats.find(key), std::string::npos) << key;
   }
 }
@@ -106,9 +101,9 @@ TEST(OfflineTracker, MissingAndDamagedFramesAreDroppedNotFatal) {
   test::TempDir tmp("track_damaged");
   const std::string rec = tmp.path() + "/rec";
   std::filesystem::copy(src, rec, std::filesystem::copy_options::recursive);
-  std::filesystem::remove(frame_file_path(rec, "cam1", 3));             // dropped frame
+  std::filesystem::remove(frame_file_path(rec, "cam1", 3));  // dropped frame
   test::write_file(frame_file_path(rec, "cam0", 5), "P5\n1032 776\n255\n\x01\x02");  // truncated
-  test::write_file(frame_file_path(rec, "cam1", 7), "");                              // empty
+  test::write_file(frame_file_path(rec, "cam1", 7), "");                             // empty
   std::vector<std::string> warnings;
   OfflineTrackResult r = track_or_fail(rec, tmp.path() + "/out", false, &warnings);
   EXPECT_EQ(r.frames, 12);

@@ -1,0 +1,86 @@
+// Design: see latency_histogram.h. Report-time code: walks the 2304 buckets.
+#include "pipeline/latency_histogram.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace mocap::pipeline {
+namespace {
+
+// Nearest rank: the smallest value with at least ceil(q * count) samples at or below it.
+template <class CountAt>
+std::int64_t percentile_ns(std::uint64_t total, double q, std::int64_t max_ns, CountAt count_at) {
+  if (total == 0) return 0;
+  const double want = std::ceil(q * static_cast<double>(total));
+  const std::uint64_t rank = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(want));
+  std::uint64_t seen = 0;
+  for (std::size_t b = 0; b < LatencyHistogram::kBuckets; ++b) {
+    seen += count_at(b);
+    if (seen >= rank) return std::min(LatencyHistogram::upper_bound_of(b), max_ns);
+  }
+  return max_ns;
+}
+
+}  // namespace
+
+void LatencyHistogram::reset() noexcept {
+  // relaxed: no reader relies on ordering between these fields (file comment).
+  for (auto& b : buckets_) b.store(0, std::memory_order_relaxed);
+  count_.store(0, std::memory_order_relaxed);
+  sum_ns_.store(0, std::memory_order_relaxed);
+  max_ns_.store(0, std::memory_order_relaxed);
+}
+
+double LatencyHistogram::percentile_us(double q) const noexcept {
+  std::uint64_t total = 0;
+  // relaxed loads throughout: approximate while the writer runs (file comment). The
+  // total is the sum of the buckets read here, so the rank is always reachable.
+  for (const auto& b : buckets_) total += b.load(std::memory_order_relaxed);
+  const std::int64_t max = std::max(max_ns(), std::int64_t{0});
+  const std::int64_t ns = percentile_ns(
+      total, q, max, [&](std::size_t b) { return buckets_[b].load(std::memory_order_relaxed); });
+  return static_cast<double>(ns) * 1e-3;
+}
+
+LatencySnapshot LatencyHistogram::snapshot() const {
+  LatencySnapshot s;
+  s.buckets.resize(kBuckets);
+  // relaxed: see percentile_us(); count is the sum of the copied buckets.
+  for (std::size_t b = 0; b < kBuckets; ++b) {
+    s.buckets[b] = buckets_[b].load(std::memory_order_relaxed);
+    s.count += s.buckets[b];
+  }
+  s.sum_ns = sum_ns_.load(std::memory_order_relaxed);
+  s.max_ns = max_ns_.load(std::memory_order_relaxed);
+  return s;
+}
+
+LatencySnapshot LatencySnapshot::since(const LatencySnapshot& earlier) const {
+  LatencySnapshot d;
+  d.buckets.resize(buckets.size());
+  std::size_t highest = 0;
+  for (std::size_t b = 0; b < buckets.size(); ++b) {
+    const std::uint64_t before = b < earlier.buckets.size() ? earlier.buckets[b] : 0;
+    d.buckets[b] = buckets[b] >= before ? buckets[b] - before : 0;
+    d.count += d.buckets[b];
+    if (d.buckets[b] > 0) highest = b;
+  }
+  d.sum_ns = sum_ns >= earlier.sum_ns ? sum_ns - earlier.sum_ns : 0;
+  d.max_ns = d.count == 0 ? 0 : std::min(LatencyHistogram::upper_bound_of(highest), max_ns);
+  return d;
+}
+
+LatencyStats LatencySnapshot::stats() const {
+  LatencyStats s;
+  s.count = count;
+  if (count == 0) return s;
+  const auto at = [&](std::size_t b) { return b < buckets.size() ? buckets[b] : 0; };
+  s.p50_us = static_cast<double>(percentile_ns(count, 0.50, max_ns, at)) * 1e-3;
+  s.p99_us = static_cast<double>(percentile_ns(count, 0.99, max_ns, at)) * 1e-3;
+  s.p999_us = static_cast<double>(percentile_ns(count, 0.999, max_ns, at)) * 1e-3;
+  s.max_us = static_cast<double>(max_ns) * 1e-3;
+  s.mean_us = static_cast<double>(sum_ns) / static_cast<double>(count) * 1e-3;
+  return s;
+}
+
+}  // namespace mocap::pipeline

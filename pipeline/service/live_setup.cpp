@@ -1,0 +1,202 @@
+// Design: see live_setup.h.
+#include "pipeline/service/live_setup.h"
+
+#include <cstring>
+
+#include "config/tracking_assets.h"
+#include "hal/replay_camera.h"
+#include "hal/v4l2_camera.h"
+#include "pipeline/service/stalling_camera.h"
+#ifdef MOCAP_HAVE_LIBCAMERA
+#include "hal/libcamera_camera.h"
+#endif
+
+namespace mocap::service {
+
+using config::CameraBackend;
+
+static_assert(config::kStageCount == pipeline::kStageCount,
+              "config::kStageNames lists the stages of pipeline/stage_table.h");
+
+Expected<config::RunConfig> resolve_run_config(const std::string& path, const CliOverrides& cli) {
+  config::RunConfig cfg = config::default_run_config();
+  if (!path.empty()) {
+    auto loaded = config::load_run_config(path);
+    if (!loaded) return loaded.error();
+    cfg = std::move(loaded).value();
+  }
+  if (cli.udp) {
+    if (auto r = config::check_host_port("--udp", "", *cli.udp); !r) return r.error();
+    cfg.outputs.udp = {*cli.udp};
+  }
+  if (cli.rate_hz) cfg.pipeline.trigger_rate_hz = *cli.rate_hz;
+  if (cli.loop_frames) cfg.sim.loop_frames = *cli.loop_frames;
+  if (cli.no_realtime) cfg.pipeline.realtime = false;
+  if (cli.no_iceoryx) cfg.outputs.iceoryx = false;
+  return cfg;
+}
+
+int check_config_command(const std::string& path) {
+  auto cfg = config::load_run_config(path);
+  if (!cfg) {
+    std::fprintf(stderr, "mocap: %s\n", cfg.error().message.c_str());
+    return 1;
+  }
+  std::printf("%s: OK (%s cameras, %.0f Hz, %zu UDP destination(s), iceoryx %s)\n", path.c_str(),
+              config::to_string(cfg->cameras[0].backend), cfg->pipeline.trigger_rate_hz,
+              cfg->outputs.udp.size(), cfg->outputs.iceoryx ? "on" : "off");
+  return 0;
+}
+
+pipeline::PipelineOptions pipeline_options(const config::RunConfig& cfg) {
+  pipeline::PipelineOptions o;
+  o.trigger_rate_hz = cfg.pipeline.trigger_rate_hz;
+  o.pacing = cfg.pipeline.pacing == config::Pacing::kLockstep ? pipeline::TriggerPacing::kLockstep
+                                                              : pipeline::TriggerPacing::kPeriodic;
+  o.realtime = cfg.pipeline.realtime;
+  o.lock_memory = cfg.pipeline.lock_memory;
+  o.dequeue_timeout_ms = cfg.pipeline.dequeue_timeout_ms;
+  for (std::size_t i = 0; i < config::kStageCount; ++i) {
+    const config::StageSettings& s = cfg.pipeline.stages[i];
+    pipeline::StageSpec& d = o.stages[i];
+    if (s.cpu) d.cpu = *s.cpu;
+    if (s.priority) d.fifo_priority = *s.priority;
+    if (s.ring_depth) d.ring_depth = *s.ring_depth;
+  }
+  return o;
+}
+
+namespace {
+
+hal::TriggerMode to_hal(config::TriggerKind t) {
+  switch (t) {
+    case config::TriggerKind::kFreeRun:
+      return hal::TriggerMode::kFreeRun;
+    case config::TriggerKind::kExternal:
+      return hal::TriggerMode::kExternal;
+    case config::TriggerKind::kSoftware:
+      return hal::TriggerMode::kSoftware;
+  }
+  return hal::TriggerMode::kFreeRun;
+}
+
+// The configured settings on top of `base` (the backend's native configuration).
+hal::CameraConfig camera_config(const config::CameraSettings& s, hal::CameraConfig base,
+                                const CameraModel& rig_camera, std::uint32_t detect_ring_depth) {
+  if (s.backend == CameraBackend::kV4l2 || s.backend == CameraBackend::kLibcamera) {
+    base.format = s.format;
+    base.width = s.width != 0 ? s.width : rig_camera.width;
+    base.height = s.height != 0 ? s.height : rig_camera.height;
+    if (s.exposure_us) base.exposure_us = *s.exposure_us;
+    if (s.gain) base.gain = *s.gain;
+  }
+  if (s.trigger) base.trigger = to_hal(*s.trigger);
+  if (s.frame_rate_hz) base.frame_rate_hz = *s.frame_rate_hz;
+  base.buffer_count = s.buffers ? *s.buffers : static_cast<int>(detect_ring_depth + 3);
+  return base;
+}
+
+void say(std::FILE* log, const std::string& line) {
+  if (log != nullptr) std::fprintf(log, "mocap run: %s\n", line.c_str());
+}
+
+}  // namespace
+
+Expected<std::unique_ptr<LiveSetup>> LiveSetup::create(const config::RunConfig& cfg,
+                                                       std::FILE* log) {
+  std::unique_ptr<LiveSetup> s(new LiveSetup());
+  s->options_ = pipeline_options(cfg);
+  const CameraBackend backend = cfg.cameras[0].backend;
+  Expected<config::TrackingAssets> assets = Error{};
+  std::shared_ptr<hal::LibcameraSession> session;
+  std::array<std::unique_ptr<hal::Camera>, 2> cams;
+  std::array<hal::CameraConfig, 2> native{};
+  if (backend == CameraBackend::kSim) {
+    say(log, "rendering the simulated camera loop (" + std::to_string(cfg.sim.loop_frames) +
+                 " frames x 2 cameras)...");
+    auto loop = hal::SimFrameLoop::render(config::sim_options(cfg));
+    if (!loop) return loop.error();
+    s->loop_ = std::move(loop).value();
+    say(log,
+        "simulated loop ready (" + std::to_string(s->loop_->memory_bytes() / 1'000'000) + " MB)");
+    s->trigger_ = std::make_shared<hal::SimTrigger>(s->loop_);
+    const sim::SimScene& scene = s->loop_->scene();
+    assets = config::load_tracking_assets(cfg, &scene.rig, &scene.targets, &scene.joints_true);
+    for (int c = 0; c < 2; ++c) {
+      auto cam = hal::SimCamera::open(s->trigger_, c);
+      if (!cam) return cam.error();
+      native[static_cast<std::size_t>(c)] = (*cam)->native_config();
+      cams[static_cast<std::size_t>(c)] = std::move(cam).value();
+    }
+  } else if (backend == CameraBackend::kReplay) {
+    auto rec = Recording::open(cfg.cameras[0].device);
+    if (!rec) return rec.error();
+    s->recording_ = std::make_shared<const Recording>(std::move(rec).value());
+    assets = config::load_tracking_assets(cfg, &s->recording_->rig(), nullptr, nullptr);
+    for (int c = 0; c < 2; ++c) {
+      auto cam = hal::ReplayCamera::open(s->recording_, c, hal::ReplayPacing::kRecordedTiming);
+      if (!cam) return cam.error();
+      native[static_cast<std::size_t>(c)] = (*cam)->native_config();
+      cams[static_cast<std::size_t>(c)] = std::move(cam).value();
+    }
+  } else {
+    assets = config::load_tracking_assets(cfg, nullptr, nullptr, nullptr);
+    if (!assets) return assets.error();
+    for (std::size_t c = 0; c < 2; ++c) {
+      const std::string& device = cfg.cameras[c].device;
+      if (backend == CameraBackend::kV4l2) {
+        auto cam = hal::V4l2Camera::open(device);
+        if (!cam) return cam.error();
+        cams[c] = std::move(cam).value();
+      } else {
+#ifdef MOCAP_HAVE_LIBCAMERA
+        if (!session) {
+          auto got = hal::LibcameraSession::get();
+          if (!got) return got.error();
+          session = std::move(got).value();
+        }
+        auto cam = hal::LibcameraCamera::open(session, device);
+        if (!cam) return cam.error();
+        cams[c] = std::move(cam).value();
+#else
+        return make_error(
+            cfg.path, "cameras[0].backend",
+            "libcamera support is not built in (libcamera-dev missing at build time)");
+#endif
+      }
+    }
+  }
+  if (!assets) return assets.error();
+
+  for (std::size_t c = 0; c < 2; ++c) {
+    const std::uint32_t depth =
+        s->options_.stages[pipeline::index(pipeline::StageId::kDetect0) + c].ring_depth;
+    const hal::CameraConfig want =
+        camera_config(cfg.cameras[c], native[c], assets->rig.cameras[c], depth);
+    if (auto r = cams[c]->configure(want); !r) return r.error();
+    if (c == 0 && cfg.faults.stall_after_frames > 0) {
+      say(log, "fault injection: camera 0 stalls after " +
+                   std::to_string(cfg.faults.stall_after_frames) + " frames");
+      cams[c] = std::make_unique<StallingCamera>(std::move(cams[c]), cfg.faults.stall_after_frames);
+    }
+  }
+  s->cams_ = std::move(cams);
+
+  const JointModel* model = assets->model ? &*assets->model : nullptr;
+  if (model == nullptr)
+    say(log, "note: no joint model: poses are tracked, no joint angles are sent");
+  auto proc = FrameProcessor::create(assets->rig, assets->targets, model, cfg.tracker);
+  if (!proc) return proc.error();
+  s->processor_.emplace(std::move(proc).value());
+  return s;
+}
+
+std::vector<std::string> LiveSetup::notices() const {
+  std::vector<std::string> out;
+  for (const auto& c : cams_) {
+    if (c && !c->notice().empty()) out.push_back(c->name() + ": " + c->notice());
+  }
+  return out;
+}
+
+}  // namespace mocap::service

@@ -1,0 +1,70 @@
+// Design: from a validated RunConfig (src/config) to the objects `mocap run` starts:
+// the cameras of the configured backend (opened and configured, wrapped for fault
+// injection when asked), the tracker (FrameProcessor with the configured thresholds,
+// rig, targets and model), the pipeline options (stage table overrides applied on top
+// of pipeline::kDefaultStages) and the publishers' destinations. This is the one place
+// that maps the configuration's plain data onto hal:: and pipeline:: types, because
+// src/config is built before them. Setup code: allocates, returns one-line errors.
+#pragma once
+
+#include <array>
+#include <cstdio>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "config/run_config.h"
+#include "core/expected.h"
+#include "formats/recording.h"
+#include "hal/camera.h"
+#include "hal/sim_camera.h"
+#include "pipeline/pipeline.h"
+#include "track/frame_processor.h"
+
+namespace mocap::service {
+
+// Command-line flags of `mocap run` that override the configuration file.
+struct CliOverrides {
+  std::optional<std::string> udp;  // --udp HOST:PORT replaces outputs.udp
+  std::optional<double> rate_hz;   // --rate
+  std::optional<int> loop_frames;  // --loop-frames (sim backend)
+  bool no_realtime = false;        // --no-realtime
+  bool no_iceoryx = false;         // --no-iceoryx
+};
+
+// The configuration file (or the built-in defaults when `path` is empty) with the
+// command line's overrides applied and checked.
+Expected<config::RunConfig> resolve_run_config(const std::string& path, const CliOverrides& cli);
+
+// `mocap run --check-config FILE`: prints "FILE: OK (...)" on stdout and returns 0, or
+// the one-line error on stderr and returns 1.
+int check_config_command(const std::string& path);
+
+// pipeline::PipelineOptions from the configuration (stage table overrides included).
+pipeline::PipelineOptions pipeline_options(const config::RunConfig& cfg);
+
+class LiveSetup {
+ public:
+  // Renders the sim loop / opens the recording / opens the devices, configures the
+  // cameras and builds the tracker. Progress lines go to `log` (may be null).
+  static Expected<std::unique_ptr<LiveSetup>> create(const config::RunConfig& cfg, std::FILE* log);
+
+  std::array<hal::Camera*, 2> cameras() const noexcept { return {cams_[0].get(), cams_[1].get()}; }
+  // The tracker, to be moved into the pipeline (once).
+  FrameProcessor take_processor() { return std::move(*processor_); }
+  const pipeline::PipelineOptions& options() const noexcept { return options_; }
+  // One line per camera fallback (hal::Camera::notice), empty entries left out.
+  std::vector<std::string> notices() const;
+
+ private:
+  LiveSetup() = default;
+  std::shared_ptr<const hal::SimFrameLoop> loop_;
+  std::shared_ptr<hal::SimTrigger> trigger_;
+  std::shared_ptr<const Recording> recording_;
+  std::array<std::unique_ptr<hal::Camera>, 2> cams_;
+  std::optional<FrameProcessor> processor_;
+  pipeline::PipelineOptions options_;
+};
+
+}  // namespace mocap::service

@@ -1,0 +1,57 @@
+// Design: strict, typed access to one YAML map of the run configuration (internal to
+// mocap_config). A Section is built with the list of keys it accepts and rejects any
+// other key at once ("cameras[0].exposure: unknown key (line 7); expected one of: ..."),
+// so a typo is never silently ignored. The typed getters return std::nullopt when the
+// key is absent and throw formats_detail::FieldError (converted to the one-line
+// "FILE: key: problem" at the loader's boundary) when the value is malformed or out of
+// range; ranges are inclusive unless stated.
+#pragma once
+
+#include <yaml-cpp/yaml.h>
+
+#include <cstdint>
+#include <initializer_list>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+namespace mocap::config_detail {
+
+class Section {
+ public:
+  // `node` must be a map (or absent/null: an empty section). Throws on unknown keys.
+  Section(const YAML::Node& node, std::string where, std::initializer_list<std::string_view> keys);
+
+  const std::string& where() const noexcept { return where_; }
+  bool has(std::string_view key) const;
+  YAML::Node node(std::string_view key) const;  // undefined when absent
+  std::string path(std::string_view key) const;
+  std::string line(std::string_view key) const;  // " (line N)" of the value, or ""
+
+  std::optional<double> number(std::string_view key, double lo, double hi) const;
+  std::optional<std::int64_t> integer(std::string_view key, std::int64_t lo, std::int64_t hi) const;
+  std::optional<bool> flag(std::string_view key) const;
+  std::optional<std::string> text(std::string_view key) const;  // non-empty
+  // One of `choices` (exact spelling); the error lists them.
+  template <class E>
+  std::optional<E> choice(std::string_view key,
+                          std::initializer_list<std::pair<std::string_view, E>> choices) const {
+    const std::optional<std::string> s = text(key);
+    if (!s) return std::nullopt;
+    std::string list;
+    for (const auto& [name, value] : choices) {
+      if (*s == name) return value;
+      list += (list.empty() ? "" : "|") + std::string(name);
+    }
+    bad(key, "expected " + list + ", got '" + *s + "'");
+  }
+  [[noreturn]] void bad(std::string_view key, const std::string& problem) const;
+
+ private:
+  YAML::Node map_;
+  std::string where_;
+};
+
+}  // namespace mocap::config_detail

@@ -1,0 +1,345 @@
+// Design: the YAML reader of the run configuration (run_config.h). One function per
+// section, each a Section with its accepted keys (unknown keys fail at once) and typed,
+// range-checked getters; cross-key rules (same backend on both cameras, device needed
+// or forbidden by the backend, ...) follow the per-key checks; finally the referenced
+// files are loaded and the whole tracker is built once (tracking_assets.h) so that a
+// configuration that passes here cannot fail later for a reason visible in the files.
+#include "config/run_config.h"
+
+#include <unistd.h>
+
+#include <filesystem>
+
+#include "config/config_reader.h"
+#include "config/tracking_assets.h"
+#include "formats/text_io.h"
+#include "formats/yaml_read.h"
+
+namespace mocap::config {
+
+using config_detail::Section;
+using formats_detail::fail;
+using formats_detail::index_path;
+using formats_detail::line_suffix;
+
+const char* to_string(CameraBackend b) noexcept {
+  switch (b) {
+    case CameraBackend::kSim:
+      return "sim";
+    case CameraBackend::kReplay:
+      return "replay";
+    case CameraBackend::kV4l2:
+      return "v4l2";
+    case CameraBackend::kLibcamera:
+      return "libcamera";
+  }
+  return "?";
+}
+
+const char* to_string(TriggerKind t) noexcept {
+  switch (t) {
+    case TriggerKind::kFreeRun:
+      return "free_run";
+    case TriggerKind::kExternal:
+      return "external";
+    case TriggerKind::kSoftware:
+      return "software";
+  }
+  return "?";
+}
+
+RunConfig default_run_config() { return RunConfig{}; }
+
+namespace {
+
+// Empty when `value` is a valid HOST:PORT, else the problem.
+std::string host_port_problem(const std::string& value) {
+  const std::size_t colon = value.rfind(':');
+  if (colon == std::string::npos || colon == 0 || colon + 1 == value.size())
+    return "expected HOST:PORT, got '" + value + "'";
+  int port = 0;
+  for (std::size_t i = colon + 1; i < value.size(); ++i) {
+    if (value[i] < '0' || value[i] > '9' || port > 65535) return "bad port in '" + value + "'";
+    port = port * 10 + (value[i] - '0');
+  }
+  if (port < 1 || port > 65535) return "port must be in 1..65535, got '" + value + "'";
+  return {};
+}
+
+}  // namespace
+
+Expected<void> check_host_port(const std::string& file, const std::string& where,
+                               const std::string& value) {
+  const std::string problem = host_port_problem(value);
+  if (!problem.empty()) return make_error(file, where, problem);
+  return {};
+}
+
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string resolve(const std::string& base_dir, const std::string& p) {
+  fs::path path(p);
+  if (path.is_relative()) path = fs::path(base_dir) / path;
+  path = path.lexically_normal();
+  if (!path.has_filename() && path.has_parent_path()) path = path.parent_path();  // "rec/"
+  return path.string();
+}
+
+// > 0 and <= hi.
+std::optional<double> positive(const Section& s, std::string_view key, double hi) {
+  const auto v = s.number(key, 0.0, hi);
+  if (v && *v <= 0.0) s.bad(key, "must be > 0");
+  return v;
+}
+
+template <class T, class U>
+void set(T& dst, const std::optional<U>& v) {
+  if (v) dst = static_cast<T>(*v);
+}
+
+void read_camera(const YAML::Node& node, const std::string& where, const std::string& dir,
+                 CameraSettings& cam) {
+  const Section s(node, where,
+                  {"backend", "device", "format", "width", "height", "exposure_us", "gain",
+                   "trigger", "frame_rate_hz", "buffers"});
+  if (!s.has("backend")) fail(s.path("backend"), "missing key" + line_suffix(node));
+  cam.backend = *s.choice<CameraBackend>("backend", {{"sim", CameraBackend::kSim},
+                                                     {"replay", CameraBackend::kReplay},
+                                                     {"v4l2", CameraBackend::kV4l2},
+                                                     {"libcamera", CameraBackend::kLibcamera}});
+  const char* backend = to_string(cam.backend);
+  const bool native = cam.backend == CameraBackend::kSim || cam.backend == CameraBackend::kReplay;
+  if (const auto d = s.text("device")) {
+    if (cam.backend == CameraBackend::kSim) s.bad("device", "not used by the sim backend");
+    cam.device = cam.backend == CameraBackend::kLibcamera ? *d : resolve(dir, *d);
+  } else if (cam.backend != CameraBackend::kSim) {
+    fail(s.path("device"), std::string("missing key (the ") + backend + " backend needs " +
+                               (cam.backend == CameraBackend::kReplay ? "the recording folder"
+                                : cam.backend == CameraBackend::kV4l2 ? "the device node"
+                                                                      : "a camera id or index") +
+                               ")" + line_suffix(node));
+  }
+  set(cam.format, s.choice<PixelFormat>(
+                      "format", {{"GREY", PixelFormat::kMono8}, {"Y16", PixelFormat::kMono16}}));
+  for (const char* key : {"width", "height", "exposure_us", "gain", "format"}) {
+    if (native && s.has(key))
+      s.bad(key, std::string("not used by the ") + backend + " backend (its images set it)");
+  }
+  set(cam.width, s.integer("width", 1, 32768));
+  set(cam.height, s.integer("height", 1, 32768));
+  if ((cam.width == 0) != (cam.height == 0)) {
+    fail(s.path(cam.width == 0 ? "width" : "height"),
+         "width and height must be given together" + line_suffix(node));
+  }
+  if (const auto v = s.integer("exposure_us", 1, 10'000'000))
+    cam.exposure_us = static_cast<int>(*v);
+  if (const auto v = s.number("gain", 0.0, 1e6)) cam.gain = *v;
+  cam.trigger = s.choice<TriggerKind>("trigger", {{"free_run", TriggerKind::kFreeRun},
+                                                  {"external", TriggerKind::kExternal},
+                                                  {"software", TriggerKind::kSoftware}});
+  cam.frame_rate_hz = positive(s, "frame_rate_hz", 10000.0);
+  if (const auto v = s.integer("buffers", 2, 64)) cam.buffers = static_cast<int>(*v);
+}
+
+void read_cameras(const YAML::Node& node, const std::string& dir, RunConfig& cfg) {
+  formats_detail::require_list(node, "cameras");
+  if (node.size() != 2) {
+    fail("cameras", "expected 2 cameras (the stereo pair), got " + std::to_string(node.size()) +
+                        line_suffix(node));
+  }
+  for (std::size_t c = 0; c < 2; ++c)
+    read_camera(node[c], index_path("cameras", c), dir, cfg.cameras[c]);
+  const CameraSettings &a = cfg.cameras[0], &b = cfg.cameras[1];
+  if (a.backend != b.backend) {
+    fail("cameras[1].backend", std::string("must match cameras[0].backend (") +
+                                   to_string(a.backend) + "), got " + to_string(b.backend) +
+                                   line_suffix(node[1]));
+  }
+  if (a.backend == CameraBackend::kReplay && a.device != b.device) {
+    fail("cameras[1].device", "must name the same recording as cameras[0].device (" + a.device +
+                                  ")" + line_suffix(node[1]));
+  }
+  if (a.backend != CameraBackend::kReplay && a.backend != CameraBackend::kSim &&
+      a.device == b.device) {
+    fail("cameras[1].device",
+         "the same device as cameras[0]: '" + a.device + "'" + line_suffix(node[1]));
+  }
+}
+
+void read_pipeline(const YAML::Node& node, PipelineSettings& p) {
+  const Section s(
+      node, "pipeline",
+      {"trigger_rate_hz", "pacing", "realtime", "lock_memory", "dequeue_timeout_ms", "stages"});
+  set(p.trigger_rate_hz, positive(s, "trigger_rate_hz", 10000.0));
+  set(p.pacing, s.choice<Pacing>(
+                    "pacing", {{"periodic", Pacing::kPeriodic}, {"lockstep", Pacing::kLockstep}}));
+  set(p.realtime, s.flag("realtime"));
+  set(p.lock_memory, s.flag("lock_memory"));
+  set(p.dequeue_timeout_ms, s.integer("dequeue_timeout_ms", 1, 1000));
+  const Section stages(
+      s.node("stages"), s.path("stages"),
+      {kStageNames[0], kStageNames[1], kStageNames[2], kStageNames[3], kStageNames[4]});
+  const long cpus = sysconf(_SC_NPROCESSORS_CONF);
+  for (std::size_t i = 0; i < kStageCount; ++i) {
+    const Section st(stages.node(kStageNames[i]), stages.path(kStageNames[i]),
+                     {"cpu", "priority", "ring_depth"});
+    StageSettings& out = p.stages[i];
+    if (const auto v = st.integer("cpu", -1, 1023)) {
+      if (cpus > 0 && *v >= cpus)
+        st.bad("cpu", "this machine has CPUs 0.." + std::to_string(cpus - 1) + ", got " +
+                          std::to_string(*v));
+      out.cpu = static_cast<int>(*v);
+    }
+    if (const auto v = st.integer("priority", 0, 99)) out.priority = static_cast<int>(*v);
+    if (i == 0 && st.has("ring_depth")) st.bad("ring_depth", "the capture stage has no input ring");
+    if (const auto v = st.integer("ring_depth", 2, 1024))
+      out.ring_depth = static_cast<std::uint32_t>(*v);
+  }
+}
+
+void read_outputs(const YAML::Node& node, OutputSettings& o) {
+  const Section s(node, "outputs", {"udp", "iceoryx"});
+  if (s.has("udp")) {
+    const YAML::Node list = s.node("udp");
+    o.udp.clear();
+    if (!list.IsNull()) {
+      formats_detail::require_list(list, s.path("udp"));
+      for (std::size_t i = 0; i < list.size(); ++i) {
+        const std::string where = index_path(s.path("udp"), i);
+        const std::string v = formats_detail::get_string(list[i], where);
+        const std::string problem = host_port_problem(v);
+        if (!problem.empty()) fail(where, problem + line_suffix(list[i]));
+        o.udp.push_back(v);
+      }
+    }
+  }
+  set(o.iceoryx, s.flag("iceoryx"));
+}
+
+void read_detection(const YAML::Node& node, detect::DetectorConfig& d) {
+  const Section s(
+      node, "detection",
+      {"threshold_mode", "threshold_dn", "background_dn", "threshold_sigma", "min_contrast_dn",
+       "min_area_px", "max_area_px", "max_elongation", "border", "max_blobs", "roi"});
+  set(d.threshold_mode, s.choice<detect::ThresholdMode>(
+                            "threshold_mode", {{"adaptive", detect::ThresholdMode::kAdaptive},
+                                               {"fixed", detect::ThresholdMode::kFixed}}));
+  set(d.threshold_dn, s.integer("threshold_dn", 1, 65535));
+  set(d.background_dn, s.integer("background_dn", 0, 65534));
+  if (d.background_dn >= d.threshold_dn && (s.has("background_dn") || s.has("threshold_dn")))
+    s.bad(s.has("background_dn") ? "background_dn" : "threshold_dn",
+          "background_dn must be below threshold_dn");
+  set(d.threshold_sigma, s.number("threshold_sigma", 0.0, 1000.0));
+  set(d.min_contrast_dn, s.integer("min_contrast_dn", 1, 65535));
+  set(d.min_area_px, s.integer("min_area_px", 1, 1'000'000));
+  set(d.max_area_px, s.integer("max_area_px", 1, 100'000'000));
+  if (d.max_area_px < d.min_area_px)
+    s.bad(s.has("max_area_px") ? "max_area_px" : "min_area_px",
+          "max_area_px must be >= min_area_px");
+  set(d.max_elongation, s.number("max_elongation", 1.0, 100.0));
+  set(d.border,
+      s.choice<detect::BorderPolicy>("border", {{"flag", detect::BorderPolicy::kFlag},
+                                                {"reject", detect::BorderPolicy::kReject}}));
+  set(d.max_blobs, s.integer("max_blobs", 1, 1 << 20));
+  if (s.has("roi")) {
+    const Section r(s.node("roi"), s.path("roi"), {"x", "y", "width", "height"});
+    set(d.roi.x, r.integer("x", 0, 32767));
+    set(d.roi.y, r.integer("y", 0, 32767));
+    set(d.roi.width, r.integer("width", 1, 32768));
+    set(d.roi.height, r.integer("height", 1, 32768));
+    if (!r.has("width") || !r.has("height"))
+      fail(s.path("roi"), "width and height are required" + line_suffix(s.node("roi")));
+  }
+}
+
+void read_stereo(const YAML::Node& node, StereoConfig& c) {
+  const Section s(node, "stereo",
+                  {"epipolar_tolerance_px", "max_reproj_px", "min_depth_mm", "max_depth_mm",
+                   "max_points_per_camera"});
+  set(c.epipolar_tolerance_px, positive(s, "epipolar_tolerance_px", 100.0));
+  set(c.max_reproj_px, positive(s, "max_reproj_px", 100.0));
+  set(c.min_depth_mm, s.number("min_depth_mm", 0.0, 1e6));
+  set(c.max_depth_mm, positive(s, "max_depth_mm", 1e7));
+  if (c.max_depth_mm <= c.min_depth_mm)
+    s.bad(s.has("max_depth_mm") ? "max_depth_mm" : "min_depth_mm",
+          "max_depth_mm must be above min_depth_mm");
+  set(c.max_points_per_camera, s.integer("max_points_per_camera", 1, 32767));
+}
+
+void read_identification(const YAML::Node& node, IdentifyConfig& c) {
+  const Section s(
+      node, "identification",
+      {"t_mm", "min_markers", "best_pairs", "ambiguity_ratio", "residual_floor_mm",
+       "max_search_nodes", "temporal", "warm_gate_mm", "warm_min_markers", "max_prior_age_s",
+       "max_speed_mm_per_s", "max_angular_speed_deg_per_s", "point_sigma_mm",
+       "consistency_confidence", "exclude_partial_markers", "min_whole_markers"});
+  set(c.t_mm, positive(s, "t_mm", 1000.0));
+  set(c.min_markers, s.integer("min_markers", 3, 64));
+  set(c.best_pairs, s.integer("best_pairs", 1, 100000));
+  set(c.ambiguity_ratio, s.number("ambiguity_ratio", 0.0, 100.0));
+  set(c.residual_floor_mm, s.number("residual_floor_mm", 0.0, 100.0));
+  set(c.max_search_nodes, s.integer("max_search_nodes", 1, 1'000'000'000));
+  set(c.temporal, s.flag("temporal"));
+  set(c.warm_gate_mm, positive(s, "warm_gate_mm", 1000.0));
+  set(c.warm_min_markers, s.integer("warm_min_markers", 3, 64));
+  set(c.max_prior_age_s, s.number("max_prior_age_s", 0.0, 60.0));
+  set(c.max_speed_mm_per_s, s.number("max_speed_mm_per_s", 0.0, 1e6));
+  set(c.max_angular_speed_deg_per_s, s.number("max_angular_speed_deg_per_s", 0.0, 1e6));
+  set(c.point_sigma_mm, s.number("point_sigma_mm", 0.0, 100.0));
+  set(c.consistency_confidence, s.number("consistency_confidence", 0.99, 0.999999));
+  set(c.exclude_partial_markers, s.flag("exclude_partial_markers"));
+  set(c.min_whole_markers, s.integer("min_whole_markers", 0, 16));
+}
+
+Expected<RunConfig> parse(const std::string& path, const YAML::Node& root) {
+  RunConfig cfg;
+  cfg.path = path;
+  const std::string dir = fs::path(path).parent_path().string();
+  const std::string base = dir.empty() ? std::string(".") : dir;
+  const Section top(root, "",
+                    {"version", "cameras", "rig", "targets", "model", "pipeline", "outputs",
+                     "detection", "stereo", "identification", "sim", "service", "fault_injection"});
+  (void)top.integer("version", 1, 1);  // the only version so far; checked for the future
+  if (top.has("cameras")) read_cameras(top.node("cameras"), base, cfg);
+  if (const auto v = top.text("rig")) cfg.rig_path = resolve(base, *v);
+  if (const auto v = top.text("targets")) cfg.targets_path = resolve(base, *v);
+  if (const auto v = top.text("model")) cfg.model_path = resolve(base, *v);
+  read_pipeline(top.node("pipeline"), cfg.pipeline);
+  read_outputs(top.node("outputs"), cfg.outputs);
+  read_detection(top.node("detection"), cfg.tracker.detect);
+  read_stereo(top.node("stereo"), cfg.tracker.stereo);
+  read_identification(top.node("identification"), cfg.tracker.identify);
+  const Section sim(top.node("sim"), "sim", {"loop_frames"});
+  set(cfg.sim.loop_frames, sim.integer("loop_frames", 2, 2000));
+  if (sim.has("loop_frames") && cfg.cameras[0].backend != CameraBackend::kSim)
+    sim.bad("loop_frames", std::string("only used by the sim backend (cameras use ") +
+                               to_string(cfg.cameras[0].backend) + ")");
+  const Section svc(top.node("service"), "service", {"status_interval_s", "log_interval_s"});
+  set(cfg.service.status_interval_s, svc.number("status_interval_s", 0.1, 3600.0));
+  set(cfg.service.log_interval_s, svc.number("log_interval_s", 0.0, 86400.0));
+  const Section faults(top.node("fault_injection"), "fault_injection", {"stall_after_frames"});
+  set(cfg.faults.stall_after_frames, faults.integer("stall_after_frames", 1, 1'000'000'000'000));
+  return cfg;
+}
+
+}  // namespace
+
+Expected<RunConfig> load_run_config(const std::string& path) {
+  std::string text;
+  if (auto r = formats_detail::read_text_file(path, text); !r) return r.error();
+  auto cfg = formats_detail::guard<RunConfig>(path, [&]() -> Expected<RunConfig> {
+    const YAML::Node root = YAML::Load(text);
+    if (!root.IsDefined() || root.IsNull()) return make_error(path, "", "empty file");
+    if (!root.IsMap())
+      fail("top level",
+           "expected a map, got " + formats_detail::describe(root) + line_suffix(root));
+    return parse(path, root);
+  });
+  if (!cfg) return cfg;
+  if (auto r = check_tracking_assets(*cfg); !r) return r.error();
+  return cfg;
+}
+
+}  // namespace mocap::config

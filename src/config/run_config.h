@@ -1,0 +1,117 @@
+// Design: the configuration of `mocap run` (docs/operations.md, "Configuration file"),
+// loaded from YAML and validated COMPLETELY at load time, so that `mocap run
+// --check-config FILE` and the service's start fail with the spec's one-line error
+// "FILE: key: problem" before any thread or camera is touched. Unknown keys are errors.
+// Relative paths are resolved against the directory of the configuration file.
+//
+// This module is plain data: it is built before hal/ and pipeline/, so camera settings
+// and the stage table are described here with their own small enums, and the service
+// layer (pipeline/service/live_setup.h) maps them onto hal::CameraConfig and
+// pipeline::StageSpec. Settings left out of the file are std::nullopt / defaults and
+// keep the backend's native value or the pipeline's default table.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/expected.h"
+#include "core/image.h"
+#include "track/frame_processor.h"
+
+namespace mocap::config {
+
+enum class CameraBackend : std::uint8_t { kSim, kReplay, kV4l2, kLibcamera };
+enum class TriggerKind : std::uint8_t { kFreeRun, kExternal, kSoftware };
+enum class Pacing : std::uint8_t { kPeriodic, kLockstep };
+
+const char* to_string(CameraBackend b) noexcept;
+const char* to_string(TriggerKind t) noexcept;
+
+struct CameraSettings {
+  CameraBackend backend = CameraBackend::kSim;
+  // v4l2: the device node (/dev/video0); libcamera: a camera id or index ("0");
+  // replay: the recording folder (absolute after loading); sim: empty.
+  std::string device;
+  PixelFormat format = PixelFormat::kMono8;  // GREY | Y16
+  int width = 0;                             // 0: the device's / recording's native size
+  int height = 0;
+  std::optional<int> exposure_us;
+  std::optional<double> gain;
+  std::optional<TriggerKind> trigger;
+  std::optional<double> frame_rate_hz;  // free-run rate
+  std::optional<int> buffers;           // driver buffers; default: ring depth + 3
+};
+
+// The pipeline's stages, in the order of pipeline/stage_table.h (kDefaultStages).
+inline constexpr std::size_t kStageCount = 5;
+inline constexpr std::array<const char*, kStageCount> kStageNames = {
+    "capture", "detect0", "detect1", "identify", "publish"};
+
+struct StageSettings {                      // unset: the default table's value
+  std::optional<int> cpu;                   // -1: not pinned
+  std::optional<int> priority;              // SCHED_FIFO 1..99; 0: default policy
+  std::optional<std::uint32_t> ring_depth;  // input ring slots (capture: unused)
+};
+
+struct PipelineSettings {
+  double trigger_rate_hz = 100.0;
+  Pacing pacing = Pacing::kPeriodic;
+  bool realtime = true;     // CPU pinning + SCHED_FIFO (falls back when not permitted)
+  bool lock_memory = true;  // mlockall (falls back when not permitted)
+  int dequeue_timeout_ms = 20;
+  std::array<StageSettings, kStageCount> stages{};
+};
+
+struct OutputSettings {
+  std::vector<std::string> udp = {"127.0.0.1:7755"};  // "HOST:PORT" each, may be empty
+  bool iceoryx = true;
+};
+
+struct SimSettings {
+  int loop_frames = 200;  // frames pre-rendered for the sim backend
+};
+
+struct ServiceSettings {
+  double status_interval_s = 1.0;  // how often STATUS= (and the journal line) is updated
+  // The same line on stderr (the journal) every log_interval_s; 0: never (default: `mocap
+  // run` already prints its progress line every --stats-interval).
+  double log_interval_s = 0.0;
+};
+
+// Diagnostics and tests (docs/operations.md): make the live pipeline stall on purpose.
+struct FaultSettings {
+  std::uint64_t stall_after_frames = 0;  // camera 0 stops delivering after N frames; 0: off
+};
+
+struct RunConfig {
+  std::string path;  // the file it was loaded from; empty for the built-in defaults
+  std::array<CameraSettings, 2> cameras{};
+  std::string rig_path;      // absolute; empty: the backend's (sim scene / recording)
+  std::string targets_path;  // absolute; empty: the sim scene's (sim only)
+  std::string model_path;    // absolute; empty: sim: the scene's true model; else none
+  PipelineSettings pipeline;
+  OutputSettings outputs;
+  TrackerConfig tracker;  // detection, stereo and identification thresholds
+  SimSettings sim;
+  ServiceSettings service;
+  FaultSettings faults;
+};
+
+// The configuration `mocap run` uses without a file: the simulated stereo pair of the
+// built-in scenario, UDP to 127.0.0.1:7755 and iceoryx.
+RunConfig default_run_config();
+
+// Parses, validates every key, resolves paths and loads the referenced rig, targets and
+// model files (and the recording of the replay backend) to check that they fit together
+// with the thresholds (FrameProcessor::create). Cameras are NOT opened.
+Expected<RunConfig> load_run_config(const std::string& path);
+
+// "HOST:PORT" with a non-empty host and a port in 1..65535 (the publisher resolves the
+// host). Error names `where`.
+Expected<void> check_host_port(const std::string& file, const std::string& where,
+                               const std::string& value);
+
+}  // namespace mocap::config

@@ -1,0 +1,38 @@
+// Design: which rig, targets and joint model `mocap run` tracks with, resolved the same
+// way at load time (to validate a configuration completely) and at start (to build the
+// tracker): a file named in the configuration wins; otherwise the backend's own assets
+// (the sim scene's rig, targets and true model; the replay recording's rig.yaml);
+// hardware backends need rig and targets in the file, the model is optional (without
+// one, poses are tracked but no joint angles are published).
+#pragma once
+
+#include <optional>
+
+#include "config/run_config.h"
+#include "formats/joints_yaml.h"
+#include "formats/targets_yaml.h"
+#include "sim/simulate.h"
+
+namespace mocap::config {
+
+struct TrackingAssets {
+  Rig rig;
+  TargetSet targets;
+  std::optional<JointModel> model;
+};
+
+// The options the sim backend renders its loop with (scene, loop length, rate).
+sim::SimOptions sim_options(const RunConfig& cfg);
+
+// `native_*` are the backend's own assets, each may be null. Errors name the
+// configuration key ("FILE: rig: required by the v4l2 backend") or the loaded file.
+Expected<TrackingAssets> load_tracking_assets(const RunConfig& cfg, const Rig* native_rig,
+                                              const TargetSet* native_targets,
+                                              const JointModel* native_model);
+
+// Load-time check: resolves the assets (building the sim scene or opening the replay
+// recording, both cheap), checks the configured camera sizes against the rig and
+// builds the tracker once with the configured thresholds.
+Expected<void> check_tracking_assets(const RunConfig& cfg);
+
+}  // namespace mocap::config

@@ -1,0 +1,165 @@
+// Design: the run configuration's happy paths: the shipped example (deploy/mocap.yaml),
+// defaults, relative path resolution, the replay and v4l2 backends with real rig and
+// targets files written from the simulator's scene, and the asset resolution rules.
+#include "config/run_config.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "config/tracking_assets.h"
+#include "formats/recording.h"
+#include "formats/rig_yaml.h"
+#include "formats/targets_yaml.h"
+#include "sim/simulate.h"
+#include "tests/support/test_support.h"
+
+namespace mocap::config {
+namespace {
+
+using test::TempDir;
+using test::write_file;
+
+// rig.yaml, targets.yaml and a 2-frame recording (frames.csv only) of the sim scene.
+void write_scene_files(const std::string& dir) {
+  std::filesystem::create_directories(dir + "/rec/cam0");
+  std::filesystem::create_directories(dir + "/rec/cam1");
+  auto scene = sim::make_scene(sim::SimOptions{});
+  ASSERT_TRUE(scene) << scene.error().message;
+  ASSERT_TRUE(save_rig(dir + "/rig.yaml", scene->rig));
+  ASSERT_TRUE(save_targets(dir + "/targets.yaml", scene->targets));
+  ASSERT_TRUE(save_rig(dir + "/rec/rig.yaml", scene->rig)) << "rec/";
+  ASSERT_TRUE(save_frames_csv(dir + "/rec/frames.csv", {{0, 0}, {1, 10'000'000}}));
+}
+
+TEST(RunConfig, ShippedExampleLoads) {
+  auto cfg = load_run_config(test::source_dir() + "/deploy/mocap.yaml");
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  EXPECT_EQ(cfg->cameras[0].backend, CameraBackend::kSim);
+  EXPECT_EQ(cfg->cameras[0].trigger, TriggerKind::kSoftware);
+  EXPECT_EQ(cfg->cameras[1].trigger, TriggerKind::kExternal);
+  EXPECT_DOUBLE_EQ(cfg->pipeline.trigger_rate_hz, 100.0);
+  ASSERT_TRUE(cfg->pipeline.stages[2].cpu.has_value());
+  EXPECT_EQ(*cfg->pipeline.stages[2].cpu, 1);
+  EXPECT_EQ(*cfg->pipeline.stages[1].ring_depth, 3u);
+  EXPECT_FALSE(cfg->pipeline.stages[0].ring_depth.has_value());
+  ASSERT_EQ(cfg->outputs.udp.size(), 1u);
+  EXPECT_EQ(cfg->outputs.udp[0], "127.0.0.1:7755");
+  EXPECT_DOUBLE_EQ(cfg->tracker.detect.max_elongation, 1.3);
+  EXPECT_DOUBLE_EQ(cfg->service.status_interval_s, 1.0);
+}
+
+TEST(RunConfig, MinimalFileKeepsTheDefaults) {
+  TempDir dir("cfg_min");
+  write_file(dir.file("m.yaml"), "version: 1\n");
+  auto cfg = load_run_config(dir.file("m.yaml"));
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  const RunConfig def = default_run_config();
+  EXPECT_EQ(cfg->cameras[0].backend, def.cameras[0].backend);
+  EXPECT_EQ(cfg->outputs.udp, def.outputs.udp);
+  EXPECT_TRUE(cfg->outputs.iceoryx);
+  EXPECT_EQ(cfg->sim.loop_frames, def.sim.loop_frames);
+  EXPECT_DOUBLE_EQ(cfg->tracker.identify.t_mm, TrackerConfig{}.identify.t_mm);
+  EXPECT_EQ(cfg->faults.stall_after_frames, 0u);
+  EXPECT_FALSE(cfg->pipeline.stages[3].priority.has_value());
+}
+
+TEST(RunConfig, ThresholdsAndOutputsAreRead) {
+  TempDir dir("cfg_thr");
+  write_file(dir.file("m.yaml"),
+             "outputs: {udp: ['10.0.0.2:9000', 'robot.local:7755'], iceoryx: false}\n"
+             "detection: {threshold_mode: fixed, threshold_dn: 60, background_dn: 10,\n"
+             "            roi: {x: 10, y: 20, width: 100, height: 50}, border: reject}\n"
+             "stereo: {epipolar_tolerance_px: 1.5, min_depth_mm: 200, max_depth_mm: 5000}\n"
+             "identification: {t_mm: 4, min_markers: 4, temporal: false}\n"
+             "pipeline: {pacing: lockstep, realtime: false, stages: {publish: {cpu: -1}}}\n"
+             "fault_injection: {stall_after_frames: 50}\n");
+  auto cfg = load_run_config(dir.file("m.yaml"));
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  EXPECT_EQ(cfg->outputs.udp.size(), 2u);
+  EXPECT_FALSE(cfg->outputs.iceoryx);
+  EXPECT_EQ(cfg->tracker.detect.threshold_mode, detect::ThresholdMode::kFixed);
+  EXPECT_EQ(cfg->tracker.detect.threshold_dn, 60);
+  EXPECT_EQ(cfg->tracker.detect.roi.height, 50);
+  EXPECT_EQ(cfg->tracker.detect.border, detect::BorderPolicy::kReject);
+  EXPECT_DOUBLE_EQ(cfg->tracker.stereo.max_depth_mm, 5000.0);
+  EXPECT_EQ(cfg->tracker.identify.min_markers, 4);
+  EXPECT_FALSE(cfg->tracker.identify.temporal);
+  EXPECT_EQ(cfg->pipeline.pacing, Pacing::kLockstep);
+  EXPECT_FALSE(cfg->pipeline.realtime);
+  EXPECT_EQ(*cfg->pipeline.stages[4].cpu, -1);
+  EXPECT_EQ(cfg->faults.stall_after_frames, 50u);
+}
+
+TEST(RunConfig, EmptyUdpListDisablesUdp) {
+  TempDir dir("cfg_noudp");
+  write_file(dir.file("m.yaml"), "outputs: {udp: []}\n");
+  auto cfg = load_run_config(dir.file("m.yaml"));
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  EXPECT_TRUE(cfg->outputs.udp.empty());
+}
+
+TEST(RunConfig, HardwareBackendWithRelativeRigAndTargets) {
+  TempDir dir("cfg_v4l2");
+  write_scene_files(dir.path() + "/calib");
+  write_file(dir.file("m.yaml"),
+             "cameras:\n"
+             "  - {backend: v4l2, device: /dev/video0, format: Y16, width: 1032, height: 776,\n"
+             "     exposure_us: 500, gain: 2.5, trigger: external, buffers: 8}\n"
+             "  - {backend: v4l2, device: /dev/video1, trigger: external}\n"
+             "rig: calib/rig.yaml\n"
+             "targets: ./calib/../calib/targets.yaml\n");
+  auto cfg = load_run_config(dir.file("m.yaml"));
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  EXPECT_EQ(cfg->rig_path, dir.path() + "/calib/rig.yaml");
+  EXPECT_EQ(cfg->targets_path, dir.path() + "/calib/targets.yaml");
+  EXPECT_TRUE(cfg->model_path.empty());
+  const CameraSettings& c0 = cfg->cameras[0];
+  EXPECT_EQ(c0.device, "/dev/video0");
+  EXPECT_EQ(c0.format, PixelFormat::kMono16);
+  EXPECT_EQ(*c0.exposure_us, 500);
+  EXPECT_DOUBLE_EQ(*c0.gain, 2.5);
+  EXPECT_EQ(*c0.buffers, 8);
+  EXPECT_FALSE(cfg->cameras[1].exposure_us.has_value());
+  auto assets = load_tracking_assets(*cfg, nullptr, nullptr, nullptr);
+  ASSERT_TRUE(assets) << assets.error().message;
+  EXPECT_EQ(assets->rig.cameras.size(), 2u);
+  EXPECT_FALSE(assets->model.has_value());
+}
+
+TEST(RunConfig, ReplayBackendUsesTheRecordingsRig) {
+  TempDir dir("cfg_replay");
+  write_scene_files(dir.path());
+  write_file(dir.file("m.yaml"),
+             "cameras: [{backend: replay, device: rec}, {backend: replay, device: rec/}]\n"
+             "targets: targets.yaml\n"
+             "pipeline: {pacing: lockstep}\n");
+  auto cfg = load_run_config(dir.file("m.yaml"));
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  EXPECT_EQ(cfg->cameras[0].device, dir.path() + "/rec");
+}
+
+TEST(RunConfig, SimAssetsDefaultToTheScene) {
+  const RunConfig cfg = default_run_config();
+  auto scene = sim::make_scene(sim_options(cfg));
+  ASSERT_TRUE(scene);
+  auto a = load_tracking_assets(cfg, &scene->rig, &scene->targets, &scene->joints_true);
+  ASSERT_TRUE(a) << a.error().message;
+  ASSERT_TRUE(a->model.has_value());
+  EXPECT_EQ(a->model->joints.size(), scene->joints_true.joints.size());
+  EXPECT_TRUE(check_tracking_assets(cfg));
+}
+
+TEST(RunConfig, HostPortCheck) {
+  EXPECT_TRUE(check_host_port("f", "k", "127.0.0.1:7755"));
+  EXPECT_TRUE(check_host_port("f", "k", "[::1]:1"));
+  EXPECT_FALSE(check_host_port("f", "k", "host"));
+  EXPECT_FALSE(check_host_port("f", "k", ":7755"));
+  EXPECT_FALSE(check_host_port("f", "k", "h:0"));
+  EXPECT_FALSE(check_host_port("f", "k", "h:65536"));
+  EXPECT_FALSE(check_host_port("f", "k", "h:12a"));
+  EXPECT_EQ(check_host_port("f", "k", "h:").error().message, "f: k: expected HOST:PORT, got 'h:'");
+}
+
+}  // namespace
+}  // namespace mocap::config

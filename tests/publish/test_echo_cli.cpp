@@ -1,0 +1,93 @@
+// `mocap echo` as a user runs it: it prints one line per received datagram with the
+// sequence gap, stops after --count, and fails with one line (exit 2) when its port is
+// taken or RouDi is absent. The datagrams come from our UdpPublisher on 127.0.0.1.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <sstream>
+#include <thread>
+#include <vector>
+
+#include "client/roudi_probe.h"
+#include "client/udp_receiver.h"
+#include "pipeline/publish/udp_publisher.h"
+#include "tests/support/test_support.h"
+
+namespace mocap::publish {
+namespace {
+
+client::JointsMessage message(std::uint64_t seq) {
+  client::JointsMessage m;
+  m.sequence = seq;
+  m.capture_ns = 1;
+  m.flags = client::kFlagAllBodiesFound;
+  m.joint_count = 2;
+  m.joints[0].type = 0;
+  m.joints[0].valid = 1;
+  m.joints[0].a[0] = 0.5f;  // 28.65 deg
+  m.joints[1].index = 1;
+  m.joints[1].type = 1;
+  m.joints[1].valid = 0;
+  return m;
+}
+
+std::vector<std::string> lines_starting_with(const std::string& text, const std::string& prefix) {
+  std::vector<std::string> out;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);)
+    if (line.rfind(prefix, 0) == 0) out.push_back(line);
+  return out;
+}
+
+TEST(EchoCli, PrintsMessagesWithGapsAndStopsAfterCount) {
+  // A free port: bind an ephemeral one, note it, release it for echo.
+  int port = 0;
+  {
+    auto probe = client::UdpReceiver::create("127.0.0.1:0");
+    ASSERT_TRUE(probe.ok());
+    port = probe->port();
+  }
+  const std::string dest = "127.0.0.1:" + std::to_string(port);
+  std::atomic<bool> done{false};
+  test::RunResult result;
+  std::thread echo([&] {
+    result = test::run_mocap("echo --udp " + dest + " --count 3 --duration 20");
+    done.store(true, std::memory_order_release);
+  });
+  auto pub = UdpPublisher::create({dest});
+  ASSERT_TRUE(pub.ok()) << pub.error().message;
+  // Every third sequence number: each line after the first shows a gap of 2.
+  for (std::uint64_t s = 3; !done.load(std::memory_order_acquire) && s < 3 * 4000; s += 3) {
+    pub->publish(message(s));
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  echo.join();
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const auto lines = lines_starting_with(result.output, "seq ");
+  ASSERT_EQ(lines.size(), 3u) << result.output;
+  for (std::size_t i = 1; i < lines.size(); ++i)
+    EXPECT_NE(lines[i].find(" gap 2 "), std::string::npos) << lines[i];
+  EXPECT_NE(lines[0].find("| j0 ball 28.65 0.00 0.00 | j1 hinge -- deg"), std::string::npos)
+      << lines[0];
+  EXPECT_NE(result.output.find("mocap echo: "), std::string::npos);
+}
+
+TEST(EchoCli, PortInUseIsOneLine) {
+  auto taken = client::UdpReceiver::create("127.0.0.1:0");
+  ASSERT_TRUE(taken.ok());
+  const auto r =
+      test::run_mocap("echo --udp 127.0.0.1:" + std::to_string(taken->port()) + " --count 1");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("bind: Address already in use"), std::string::npos) << r.output;
+  EXPECT_EQ(lines_starting_with(r.output, "mocap").size(), 1u) << r.output;
+}
+
+TEST(EchoCli, IceoryxWithoutRouDiIsOneLine) {
+  if (client::roudi_running()) GTEST_SKIP() << "a RouDi runs on this machine";
+  const auto r = test::run_mocap("echo --iceoryx --count 1");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("RouDi (iox-roudi) not running"), std::string::npos) << r.output;
+}
+
+}  // namespace
+}  // namespace mocap::publish

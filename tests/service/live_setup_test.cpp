@@ -1,0 +1,137 @@
+// Design: the mapping of the run configuration onto the pipeline and the HAL: stage
+// names and overrides, command-line overrides, a sim setup built end to end from a
+// configuration (cameras configured as asked, buffers sized from the ring depth), and
+// the stalling camera of fault injection (N frames, then timeouts only).
+#include "pipeline/service/live_setup.h"
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "hal/replay_camera.h"
+#include "pipeline/service/stalling_camera.h"
+#include "tests/service/tiny_recording.h"
+#include "tests/support/test_support.h"
+
+namespace mocap::service {
+namespace {
+
+TEST(LiveSetup, StageNamesMatchThePipelineTable) {
+  for (std::size_t i = 0; i < config::kStageCount; ++i) {
+    EXPECT_EQ(std::string("mocap-") + config::kStageNames[i], pipeline::kDefaultStages[i].name);
+  }
+}
+
+TEST(LiveSetup, StageOverridesOnTopOfTheDefaultTable) {
+  config::RunConfig cfg = config::default_run_config();
+  cfg.pipeline.stages[3].cpu = 0;
+  cfg.pipeline.stages[3].ring_depth = 8;
+  cfg.pipeline.stages[4].priority = 0;
+  cfg.pipeline.pacing = config::Pacing::kLockstep;
+  cfg.pipeline.trigger_rate_hz = 250.0;
+  const pipeline::PipelineOptions o = pipeline_options(cfg);
+  EXPECT_EQ(o.stages[3].cpu, 0);
+  EXPECT_EQ(o.stages[3].ring_depth, 8u);
+  EXPECT_EQ(o.stages[3].fifo_priority, pipeline::kDefaultStages[3].fifo_priority);
+  EXPECT_EQ(o.stages[4].fifo_priority, 0);
+  EXPECT_EQ(o.stages[1].cpu, pipeline::kDefaultStages[1].cpu);
+  EXPECT_EQ(o.pacing, pipeline::TriggerPacing::kLockstep);
+  EXPECT_DOUBLE_EQ(o.trigger_rate_hz, 250.0);
+}
+
+TEST(LiveSetup, CommandLineOverridesTheFile) {
+  test::TempDir dir("svc_cli");
+  test::write_file(dir.file("m.yaml"),
+                   "outputs: {udp: ['10.0.0.9:9000'], iceoryx: true}\n"
+                   "pipeline: {trigger_rate_hz: 50}\n");
+  auto same = resolve_run_config(dir.file("m.yaml"), CliOverrides{});
+  ASSERT_TRUE(same) << same.error().message;
+  EXPECT_EQ(same->outputs.udp[0], "10.0.0.9:9000");
+  CliOverrides cli;
+  cli.udp = "127.0.0.1:9999";
+  cli.rate_hz = 120.0;
+  cli.no_iceoryx = true;
+  cli.no_realtime = true;
+  auto cfg = resolve_run_config(dir.file("m.yaml"), cli);
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  EXPECT_EQ(cfg->outputs.udp, std::vector<std::string>{"127.0.0.1:9999"});
+  EXPECT_DOUBLE_EQ(cfg->pipeline.trigger_rate_hz, 120.0);
+  EXPECT_FALSE(cfg->outputs.iceoryx);
+  EXPECT_FALSE(cfg->pipeline.realtime);
+  cli.udp = "nohost";
+  auto bad = resolve_run_config(dir.file("m.yaml"), cli);
+  ASSERT_FALSE(bad);
+  EXPECT_EQ(bad.error().message, "--udp: expected HOST:PORT, got 'nohost'");
+  auto missing = resolve_run_config(dir.file("absent.yaml"), CliOverrides{});
+  ASSERT_FALSE(missing);
+  EXPECT_NE(missing.error().message.find("absent.yaml: cannot open"), std::string::npos);
+}
+
+TEST(LiveSetup, ReplayCamerasConfiguredFromTheFile) {
+  test::TempDir dir("svc_setup");
+  test::write_tiny_recording(dir.file("rec"), 4);
+  test::write_file(dir.file("m.yaml"), test::tiny_replay_config(dir.file("rec"), ""));
+  auto cfg = config::load_run_config(dir.file("m.yaml"));
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  cfg->cameras[0].buffers = 9;
+  cfg->pipeline.stages[2].ring_depth = 5;  // detect1
+  auto setup = LiveSetup::create(*cfg, nullptr);
+  ASSERT_TRUE(setup) << setup.error().message;
+  const auto cams = (*setup)->cameras();
+  EXPECT_EQ(cams[0]->config().buffer_count, 9);
+  EXPECT_EQ(cams[1]->config().buffer_count, 8);  // detect1 ring depth + 3
+  EXPECT_EQ(cams[0]->config().trigger, hal::TriggerMode::kSoftware);
+  EXPECT_EQ(cams[0]->config().width, 64);
+  EXPECT_EQ(cams[0]->state(), hal::CameraState::kConfigured);
+  EXPECT_EQ((*setup)->options().stages[2].ring_depth, 5u);
+  FrameProcessor proc = (*setup)->take_processor();
+  EXPECT_FALSE(proc.has_model());  // no model in the file: poses only
+}
+
+TEST(LiveSetup, HardwareWithoutRigIsAConfigurationError) {
+  config::RunConfig cfg = config::default_run_config();
+  cfg.cameras[0].backend = cfg.cameras[1].backend = config::CameraBackend::kV4l2;
+  cfg.cameras[0].device = "/dev/null/video0";
+  cfg.cameras[1].device = "/dev/null/video1";
+  auto no_rig = LiveSetup::create(cfg, nullptr);
+  ASSERT_FALSE(no_rig);
+  EXPECT_EQ(no_rig.error().message, "mocap run: rig: required by the v4l2 backend");
+}
+
+TEST(StallingCamera, DeliversNFramesThenTimesOut) {
+  test::TempDir dir("svc_stallcam");
+  test::write_tiny_recording(dir.path(), 8);
+  auto rec = Recording::open(dir.path());
+  ASSERT_TRUE(rec) << rec.error().message;
+  auto shared = std::make_shared<const Recording>(std::move(rec).value());
+  auto inner = hal::ReplayCamera::open(shared, 0, hal::ReplayPacing::kAsFastAsPossible);
+  ASSERT_TRUE(inner);
+  hal::CameraConfig native = (*inner)->native_config();
+  native.trigger = hal::TriggerMode::kSoftware;
+  StallingCamera cam(std::move(inner).value(), 3);
+  ASSERT_TRUE(cam.configure(native));
+  ASSERT_TRUE(cam.start());
+  EXPECT_NE(cam.notice().find("stalls after 3 frames"), std::string::npos) << cam.notice();
+  int delivered = 0, timeouts = 0;
+  for (int i = 0; i < 6; ++i) {
+    ASSERT_EQ(cam.trigger(), hal::CameraStatus::kOk);
+    hal::Frame f;
+    const hal::CameraStatus st = cam.dequeue(f, 50);
+    if (st == hal::CameraStatus::kOk) {
+      ++delivered;
+      EXPECT_EQ(f.sequence, static_cast<std::uint64_t>(i));
+      EXPECT_EQ(cam.release(f), hal::CameraStatus::kOk);
+    } else {
+      EXPECT_EQ(st, hal::CameraStatus::kTimeout);
+      ++timeouts;
+    }
+  }
+  EXPECT_EQ(delivered, 3);
+  EXPECT_EQ(timeouts, 3);
+  EXPECT_EQ(cam.counters().frames.get(), 3u);
+  cam.stop();
+  EXPECT_EQ(cam.state(), hal::CameraState::kConfigured);
+}
+
+}  // namespace
+}  // namespace mocap::service
