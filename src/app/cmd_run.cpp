@@ -198,6 +198,8 @@ int run_live(const RunArgs& a) {
   cli.no_iceoryx = a.no_iceoryx;
   auto cfg = service::resolve_run_config(a.config, cli);
   if (!cfg) return fail(cfg.error().message);
+  // Handlers first: a SIGTERM while the sim loop renders (seconds) must still stop cleanly.
+  install_stop_handlers();
   auto live = service::LiveSetup::create(*cfg, stderr);
   if (!live) return fail(live.error().message);
   for (const std::string& n : (*live)->notices())
@@ -214,7 +216,10 @@ int run_live(const RunArgs& a) {
       pipeline::Pipeline::create((*live)->take_processor(), (*live)->cameras(), sink_list, opt);
   if (!pipe) return fail(pipe.error().message);
 
-  install_stop_handlers();
+  if (g_stop_requested.load(std::memory_order_relaxed)) {
+    std::fprintf(stderr, "mocap run: stopped before start\n");
+    return 0;
+  }
   if (auto r = (*pipe)->start(); !r) return fail(r.error().message);
   for (const std::string& n : (*pipe)->notes())
     std::fprintf(stderr, "mocap run: note: %s\n", n.c_str());

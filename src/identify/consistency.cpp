@@ -98,6 +98,8 @@ bool ConsistencyGate::enforce(const TargetModel& model, const FramePoints& frame
       r.found = false;
       return false;
     }
+    // No single marker's drop can exceed the whole sum: a small sum needs no refits.
+    if (global_ok && fit.sum_sq_mm2 <= max_drop_sq_mm2_) break;
     // Leave-one-out fits: the drop of the sum of squares when one marker leaves tests that
     // marker alone (one biased marker is diluted in the global sum); the largest drop
     // names the marker to remove.
