@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs every build, test and run dependency of the mocap tracker from Debian 12's
 # packages. Idempotent: packages already present are skipped, so a second run is quick.
-# Usage (as root, or with sudo available):  bash deploy/install-deps.sh [--with-bench-baseline]
+# Usage (as root, or with sudo available):  bash deploy/install-deps.sh
 set -euo pipefail
 
 packages=(

@@ -1,20 +1,23 @@
 // `mocap track REC --targets targets.yaml [--model model.yaml] --out DIR [--stats
 // stats.json] [--truth GT_DIR]`: offline tracking of a recording through the same
 // stages as the live pipeline (src/track). --truth (extension) compares the outputs
-// with the simulator's ground truth and prints the accuracy.
+// with the simulator's ground truth and prints the accuracy. --config (extension) takes
+// the detection, stereo and identification thresholds from a `mocap run` configuration
+// file (its other sections are validated but not used).
 #include <cstdio>
 #include <memory>
 #include <string>
 
 #include "app/command_registry.h"
 #include "app/progress.h"
+#include "config/run_config.h"
 #include "track/offline_tracker.h"
 
 namespace mocap::app {
 namespace {
 
 struct TrackArgs {
-  std::string recording, targets, model, out, stats, truth;
+  std::string recording, targets, model, out, stats, truth, config;
   bool quiet = false;
 };
 
@@ -26,6 +29,11 @@ int run_track(const TrackArgs& a) {
   opt.out_dir = a.out;
   opt.stats_path = a.stats;
   opt.truth_dir = a.truth;
+  if (!a.config.empty()) {
+    auto cfg = config::load_run_config(a.config);
+    if (!cfg) return fail(cfg.error().message);
+    opt.config = cfg->tracker;
+  }
   std::unique_ptr<ProgressBar> progress;
   opt.progress = [&](std::int64_t done, std::int64_t total) {
     if (!progress) progress = std::make_unique<ProgressBar>("track", total);
@@ -47,13 +55,21 @@ int run_track(const TrackArgs& a) {
 void register_track(CLI::App& app, int& exit_code) {
   auto args = std::make_shared<TrackArgs>();
   CLI::App* cmd = app.add_subcommand(
-      "track", "Track a recording offline: writes points.csv, poses.csv and (with --model) angles.csv");
-  cmd->add_option("recording", args->recording, "Recording folder (rig.yaml, frames.csv, cam0/, cam1/)")->required();
+      "track",
+      "Track a recording offline: writes points.csv, poses.csv and (with --model) angles.csv");
+  cmd->add_option("recording", args->recording,
+                  "Recording folder (rig.yaml, frames.csv, cam0/, cam1/)")
+      ->required();
   cmd->add_option("--targets", args->targets, "Marker targets (targets.yaml)")->required();
-  cmd->add_option("--model", args->model, "Calibrated joint model (model.yaml): enables angles.csv");
+  cmd->add_option("--model", args->model,
+                  "Calibrated joint model (model.yaml): enables angles.csv");
   cmd->add_option("--out", args->out, "Output folder")->required();
   cmd->add_option("--stats", args->stats, "Write per-stage latency statistics to this JSON file");
-  cmd->add_option("--truth", args->truth, "Ground-truth folder of a simulated recording (REC/gt): print accuracy");
+  cmd->add_option("--truth", args->truth,
+                  "Ground-truth folder of a simulated recording (REC/gt): print accuracy");
+  cmd->add_option(
+      "--config", args->config,
+      "Take the detection/stereo/identification thresholds from this run configuration (YAML)");
   cmd->add_flag("--quiet", args->quiet, "Print nothing but errors and warnings");
   cmd->callback([args, &exit_code] { exit_code = run_track(*args); });
 }

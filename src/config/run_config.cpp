@@ -274,7 +274,7 @@ void read_identification(const YAML::Node& node, IdentifyConfig& c) {
       {"t_mm", "min_markers", "best_pairs", "ambiguity_ratio", "residual_floor_mm",
        "max_search_nodes", "temporal", "warm_gate_mm", "warm_min_markers", "max_prior_age_s",
        "max_speed_mm_per_s", "max_angular_speed_deg_per_s", "point_sigma_mm",
-       "consistency_confidence", "exclude_partial_markers", "min_whole_markers"});
+       "partial_sigma_mm", "consistency_confidence", "exclude_partial_markers", "min_whole_markers"});
   set(c.t_mm, positive(s, "t_mm", 1000.0));
   set(c.min_markers, s.integer("min_markers", 3, 64));
   set(c.best_pairs, s.integer("best_pairs", 1, 100000));
@@ -288,6 +288,7 @@ void read_identification(const YAML::Node& node, IdentifyConfig& c) {
   set(c.max_speed_mm_per_s, s.number("max_speed_mm_per_s", 0.0, 1e6));
   set(c.max_angular_speed_deg_per_s, s.number("max_angular_speed_deg_per_s", 0.0, 1e6));
   set(c.point_sigma_mm, s.number("point_sigma_mm", 0.0, 100.0));
+  set(c.partial_sigma_mm, s.number("partial_sigma_mm", 0.0, 100.0));
   set(c.consistency_confidence, s.number("consistency_confidence", 0.99, 0.999999));
   set(c.exclude_partial_markers, s.flag("exclude_partial_markers"));
   set(c.min_whole_markers, s.integer("min_whole_markers", 0, 16));
@@ -328,7 +329,8 @@ Expected<RunConfig> parse(const std::string& path, const YAML::Node& root) {
 
 Expected<RunConfig> load_run_config(const std::string& path) {
   std::string text;
-  if (auto r = formats_detail::read_text_file(path, text); !r) return r.error();
+  if (auto r = formats_detail::read_text_file(path, text, formats_detail::kMaxYamlFileBytes); !r)
+    return r.error();
   auto cfg = formats_detail::guard<RunConfig>(path, [&]() -> Expected<RunConfig> {
     const YAML::Node root = YAML::Load(text);
     if (!root.IsDefined() || root.IsNull()) return make_error(path, "", "empty file");

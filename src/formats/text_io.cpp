@@ -37,7 +37,7 @@ bool iequals(std::string_view a, std::string_view b) noexcept {
 
 void fail(const std::string& where, const std::string& what) { throw FieldError{where, what}; }
 
-Expected<void> read_text_file(const std::string& path, std::string& out) {
+Expected<void> read_text_file(const std::string& path, std::string& out, std::size_t max_bytes) {
   errno = 0;
   FilePtr f(std::fopen(path.c_str(), "rb"));
   if (!f) return make_error(path, "cannot open", std::strerror(errno));
@@ -47,6 +47,13 @@ Expected<void> read_text_file(const std::string& path, std::string& out) {
     const std::size_t n = std::fread(buf.data(), 1, buf.size(), f.get());
     out.append(buf.data(), n);
     if (n < buf.size()) break;
+    // A link to /dev/zero or a runaway generator would otherwise grow `out` until the
+    // process dies: no configuration or CSV of this tool comes near the bound.
+    if (out.size() > max_bytes) {
+      out.clear();
+      return make_error(path, "cannot read",
+                        "larger than " + std::to_string(max_bytes >> 20) + " MiB");
+    }
   }
   if (std::ferror(f.get())) return make_error(path, "cannot read", std::strerror(errno));
   return {};

@@ -5,6 +5,7 @@
 // value read back is bit-identical), and YAML string quoting for names.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -32,8 +33,14 @@ Expected<T> guard_fields(const std::string& path, F&& fn) {
   }
 }
 
-// Reads the whole file into `out`. Error: "<path>: cannot open: <strerror>".
-Expected<void> read_text_file(const std::string& path, std::string& out);
+// Reads the whole file into `out`. Error: "<path>: cannot open: <strerror>", or
+// "<path>: cannot read: larger than N MiB" beyond max_bytes (a link to /dev/zero must end
+// in an error, not in an out-of-memory kill). CSVs of long recordings fit the default;
+// YAML files use kMaxYamlFileBytes.
+inline constexpr std::size_t kMaxTextFileBytes = std::size_t{1} << 30;
+inline constexpr std::size_t kMaxYamlFileBytes = std::size_t{16} << 20;
+Expected<void> read_text_file(const std::string& path, std::string& out,
+                              std::size_t max_bytes = kMaxTextFileBytes);
 // Writes (replaces) the file. Error: "<path>: cannot write: <strerror>".
 Expected<void> write_text_file(const std::string& path, std::string_view content);
 

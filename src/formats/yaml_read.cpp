@@ -9,7 +9,7 @@ namespace mocap::formats_detail {
 
 Expected<YAML::Node> load_yaml_map(const std::string& path) {
   std::string text;
-  if (auto r = read_text_file(path, text); !r) return r.error();
+  if (auto r = read_text_file(path, text, kMaxYamlFileBytes); !r) return r.error();
   return guard<YAML::Node>(path, [&]() -> Expected<YAML::Node> {
     YAML::Node root = YAML::Load(text);
     if (!root.IsDefined() || root.IsNull()) return make_error(path, "", "empty file");

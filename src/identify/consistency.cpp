@@ -24,10 +24,11 @@ double normal_quantile(double p) noexcept {
   return -num / den;
 }
 
-void swap_cols(FitPoints& a, FitPoints& b, Eigen::Index i, Eigen::Index j) noexcept {
+void swap_cols(FitPoints& a, FitPoints& b, FitWeights& w, Eigen::Index i, Eigen::Index j) noexcept {
   if (i == j) return;
   a.col(i).swap(a.col(j));
   b.col(i).swap(b.col(j));
+  std::swap(w[static_cast<std::size_t>(i)], w[static_cast<std::size_t>(j)]);
 }
 
 }  // namespace
@@ -48,6 +49,8 @@ ConsistencyGate::ConsistencyGate(const IdentifyConfig& config) noexcept
       floor2_mm2_(config.residual_floor_mm * config.residual_floor_mm) {
   if (!enabled_) return;
   const double s2 = config.point_sigma_mm * config.point_sigma_mm;
+  if (config.partial_sigma_mm > 0.0)
+    partial_weight_ = s2 / (config.partial_sigma_mm * config.partial_sigma_mm);
   for (int m = 3; m <= kMaxMarkers; ++m) {
     max_sum_sq_mm2_[static_cast<std::size_t>(m)] =
         s2 * chi2_quantile(3 * m - 6, config.consistency_confidence);
@@ -61,6 +64,7 @@ bool ConsistencyGate::enforce(const TargetModel& model, const FramePoints& frame
   if (!r.found) return false;
   // Columns: whole markers first, then partial ones.
   FitPoints src(3, kMaxMarkers), dst(3, kMaxMarkers);
+  FitWeights w{};
   std::array<std::int8_t, kMaxMarkers> marker_of_col{};
   int m = 0;
   int n_whole = 0;
@@ -70,12 +74,15 @@ bool ConsistencyGate::enforce(const TargetModel& model, const FramePoints& frame
       if (p < 0 || frame.partial(p) != (pass == 1)) continue;
       src.col(m) = model.M_body[static_cast<std::size_t>(c)];
       dst.col(m) = frame.X(p);
+      w[static_cast<std::size_t>(m)] = pass == 0 ? 1.0 : partial_weight_;
       marker_of_col[static_cast<std::size_t>(m)] = static_cast<std::int8_t>(c);
       ++m;
     }
     if (pass == 0) n_whole = m;
   }
-  if (m < 3 || n_whole < min_whole_) {
+  // A pose that rests on partial markers needs a redundant fit (at least 4 markers, so
+  // that the test below can see a biased one): with 3, every bias passes into the pose.
+  if (m < 3 || n_whole < min_whole_ || (n_whole < 3 && m < 4)) {
     stats.partial_reject = m >= 3;
     r.found = false;
     return false;
@@ -86,11 +93,11 @@ bool ConsistencyGate::enforce(const TargetModel& model, const FramePoints& frame
     r.point_of_marker[static_cast<std::size_t>(marker_of_col[static_cast<std::size_t>(i)])] = -1;
     std::swap(marker_of_col[static_cast<std::size_t>(i)],
               marker_of_col[static_cast<std::size_t>(m - 1)]);
-    swap_cols(src, dst, i, m - 1);
+    swap_cols(src, dst, w, i, m - 1);
     --m;
     ++stats.dropped;
   };
-  RigidFit fit = fit_rigid(src, dst, nf);
+  RigidFit fit = fit_rigid_weighted(src, dst, w, nf);
   while (enabled_) {
     const bool global_ok = fit.sum_sq_mm2 <= max_sum_sq_mm2(nf);
     if (nf <= min_m) {
@@ -107,9 +114,9 @@ bool ConsistencyGate::enforce(const TargetModel& model, const FramePoints& frame
     RigidFit best_fit;
     best_fit.sum_sq_mm2 = std::numeric_limits<double>::infinity();
     for (int i = 0; i < nf; ++i) {
-      swap_cols(src, dst, i, nf - 1);
-      const RigidFit f = fit_rigid(src, dst, nf - 1);
-      swap_cols(src, dst, i, nf - 1);
+      swap_cols(src, dst, w, i, nf - 1);
+      const RigidFit f = fit_rigid_weighted(src, dst, w, nf - 1);
+      swap_cols(src, dst, w, i, nf - 1);
       if (f.sum_sq_mm2 < best_fit.sum_sq_mm2) {
         best_fit = f;
         worst = i;
@@ -120,7 +127,7 @@ bool ConsistencyGate::enforce(const TargetModel& model, const FramePoints& frame
     // partial column that takes its place at nf - 1 is outside the new range [0, nf - 1)).
     std::swap(marker_of_col[static_cast<std::size_t>(worst)],
               marker_of_col[static_cast<std::size_t>(nf - 1)]);
-    swap_cols(src, dst, worst, nf - 1);
+    swap_cols(src, dst, w, worst, nf - 1);
     --nf;
     remove_col(nf);
     fit = best_fit;

@@ -21,7 +21,11 @@
 // Partial markers (MeasuredPoint::partial: the image does not look like a whole marker)
 // are identified like the others, but while at least 3 whole markers are matched the
 // pose is fitted (and tested) on the whole markers only; a partial marker stays matched
-// when it agrees with that pose within t. exclude_partial_markers = false fits all.
+// when it agrees with that pose within t. When fewer than 3 whole markers are matched
+// (and min_whole_markers allows it), or with exclude_partial_markers = false, the partial
+// markers join the fit with their own noise partial_sigma_mm: a weighted fit with weights
+// (point_sigma / sigma_i)^2, and the sums of squares above are these weighted sums, so the
+// chi-square thresholds stay those of point_sigma (residuals normalised per marker).
 #pragma once
 
 #include <array>
@@ -64,6 +68,7 @@ class ConsistencyGate {
   bool enabled_ = false;
   bool exclude_partial_ = true;
   int min_whole_ = 0;
+  double partial_weight_ = 1.0;  // (point_sigma / partial_sigma)^2
   double t2_mm2_ = 25.0;
   double floor2_mm2_ = 0.0;
   std::array<double, kMaxMarkers + 1> max_sum_sq_mm2_{};

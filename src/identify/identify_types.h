@@ -58,6 +58,10 @@ struct IdentifyConfig {
   // Set it from the `rms_mm` of a static recording (about 1.2 x that value); 0 disables.
   double point_sigma_mm = 0.2;
   double consistency_confidence = 0.9999;  // in [0.99, 0.999999]
+  // Per-coordinate noise assumed for a partial marker when it must join a pose fit
+  // (fewer than 3 whole markers, or exclude_partial_markers = false): the bias of a partly
+  // hidden marker's centroid, typically 0.3-3 mm. >= point_sigma_mm; 0: same as whole.
+  double partial_sigma_mm = 1.0;
   // Fit the pose on whole markers only while at least 3 are matched (MeasuredPoint::partial).
   bool exclude_partial_markers = true;
   // A body is reported only with at least this many whole (not partial) markers matched,

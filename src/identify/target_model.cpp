@@ -38,6 +38,11 @@ Expected<void> validate_config(const IdentifyConfig& c) {
         "must be in [3, " + std::to_string(kMaxPoints) + "], got " + std::to_string(c.max_points));
   if (!(c.point_sigma_mm >= 0.0) || !std::isfinite(c.point_sigma_mm))
     return make_error(f, "point_sigma_mm", "must be >= 0, got " + num(c.point_sigma_mm));
+  if (!std::isfinite(c.partial_sigma_mm) ||
+      !(c.partial_sigma_mm == 0.0 || c.partial_sigma_mm >= c.point_sigma_mm))
+    return make_error(f, "partial_sigma_mm",
+                      "must be 0 or >= point_sigma_mm (" + num(c.point_sigma_mm) + "), got " +
+                          num(c.partial_sigma_mm));
   if (!(c.consistency_confidence >= 0.99 && c.consistency_confidence <= 0.999999))
     return make_error(f, "consistency_confidence",
                       "must be in [0.99, 0.999999], got " + num(c.consistency_confidence));

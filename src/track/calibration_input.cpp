@@ -23,7 +23,8 @@ Expected<CollectedCalibration> collect_calibration_input(const std::string& reco
     for (std::size_t c = 0; c < 2; ++c) {
       auto loaded = rec->load_frame(static_cast<int>(c), fe.frame, images[c]);
       if (!loaded) {
-        if (opt.warn) opt.warn(loaded.error().message + " (frame " + std::to_string(fe.frame) + " skipped)");
+        if (opt.warn)
+          opt.warn(loaded.error().message + " (frame " + std::to_string(fe.frame) + " skipped)");
       } else if (*loaded == FrameLoad::kOk) {
         views[c] = images[c].view();
         present[c] = &views[c];
@@ -42,15 +43,27 @@ Expected<CollectedCalibration> collect_calibration_input(const std::string& reco
       if (!pose.found) continue;
       ++found;
       obs.T_world_body = pose.T_world_body;
-      for (std::size_t k = 0; k < targets.bodies[b].markers_body.size(); ++k) {
+      // The refinement sees the markers the pose was fitted on: while at least 3 whole
+      // markers are matched, the partial ones (centroid biased by a partly hidden image,
+      // kept matched by identification) are left out, as in the identifier's fit.
+      const std::size_t nk = targets.bodies[b].markers_body.size();
+      auto index_of = [&](std::size_t k) -> int {
         const std::int16_t idx = pose.point_index_of_marker[k];
-        if (idx < 0 || idx >= out.points.size()) continue;
+        return (idx < 0 || idx >= out.points.size()) ? -1 : idx;
+      };
+      int whole = 0;
+      for (std::size_t k = 0; k < nk; ++k)
+        whole += (index_of(k) >= 0 && !proc->point_partial(index_of(k))) ? 1 : 0;
+      for (std::size_t k = 0; k < nk; ++k) {
+        const int idx = index_of(k);
+        if (idx < 0 || (whole >= 3 && proc->point_partial(idx))) continue;
         obs.markers.push_back({static_cast<int>(k), out.points[idx].X_world});
       }
     }
     if (found == static_cast<int>(targets.bodies.size())) ++result.frames_all_bodies;
     result.input.frames.push_back(std::move(frame));
-    if (opt.progress) opt.progress(static_cast<std::int64_t>(fi + 1), static_cast<std::int64_t>(frames.size()));
+    if (opt.progress)
+      opt.progress(static_cast<std::int64_t>(fi + 1), static_cast<std::int64_t>(frames.size()));
   }
   return result;
 }

@@ -125,6 +125,7 @@ bool FrameProcessor::process_blobs(std::int64_t timestamp_ns, FrameOutput& out) 
         m.partial = true;
     }
   }
+  measured_count_ = n_points;
   const bool identified = identifier_.identify(measured_.data(), n_points, timestamp_ns, out.poses);
   now = monotonic_ns();
   out.times.identify = now - t;

@@ -88,6 +88,12 @@ class FrameProcessor {
   // Forget temporal state (identification priors, hinge unwrapping).
   void reset() noexcept;
 
+  // Whether 3D point i of the last processed frame was measured from a partial marker
+  // image (see TrackerConfig); false for an index outside that frame.
+  bool point_partial(int i) const noexcept {
+    return i >= 0 && i < measured_count_ && measured_[static_cast<std::size_t>(i)].partial;
+  }
+
   bool has_model() const noexcept { return angles_.has_value(); }
   const TargetSet& targets() const noexcept { return targets_; }
   const JointModel& model() const noexcept { return model_; }
@@ -119,6 +125,7 @@ class FrameProcessor {
   // Workspace, sized at create().
   std::array<std::vector<Vec2>, 2> centroids_px_;
   std::vector<MeasuredPoint> measured_;
+  int measured_count_ = 0;
   std::vector<kinematics::BodyPoseView> body_views_;
 };
 

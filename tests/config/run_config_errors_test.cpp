@@ -171,6 +171,8 @@ const ErrorCase kCases[] = {
     {"MinMarkers", "identification: {min_markers: 2}\n",
      "identification.min_markers: must be in [3, 64], got 2 (line 1)"},
     {"TMm", "identification: {t_mm: 0}\n", "identification.t_mm: must be > 0 (line 1)"},
+    {"PartialSigmaBelowPointSigma", "identification: {partial_sigma_mm: 0.1}\n",
+     "identification: identify: partial_sigma_mm: must be 0 or >= point_sigma_mm (0.2), got 0.1"},
     {"TemporalNotABool", "identification: {temporal: on}\n",
      "identification.temporal: expected true or false, got 'on' (line 1)"},
     {"LoopFramesWithHardware", V4L2_PAIR ASSETS "sim: {loop_frames: 20}\n",

@@ -1,7 +1,8 @@
 // Design: tests of the consistency test (identify/consistency.h): the chi-square
 // quantile, a biased marker dropped by leave-one-out (and its point freed), a solution
 // that noise cannot explain rejected, a stray completing a triangle rejected, and the
-// false-rejection rate of clean fits at the configured noise.
+// false-rejection rate of clean fits at the configured noise; the weighted fit of partial
+// markers in coverage mode and the weighted rigid fit itself.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -9,6 +10,7 @@
 
 #include "identify/consistency.h"
 #include "identify/identifier.h"
+#include "identify/rigid_fit.h"
 #include "tests/identify/identify_test_util.h"
 
 namespace mocap {
@@ -107,6 +109,7 @@ TEST(Consistency, PartialMarkersStayMatchedButOutOfTheFit) {
   cfg.temporal = false;
   IdentifyConfig all_cfg = cfg;  // every matched marker in the fit
   all_cfg.exclude_partial_markers = false;
+  all_cfg.partial_sigma_mm = 0.0;  // and weighted like whole ones
   double sum_sq_whole = 0.0, sum_sq_all = 0.0;
   for (int trial = 0; trial < 20; ++trial) {
     OneBody b = make_body(rng, 5, 0.02);
@@ -176,10 +179,82 @@ TEST(Consistency, CleanFitsAreRarelyRejected) {
   EXPECT_LE(dropped * 200, trials) << dropped << " markers dropped";
 }
 
+TEST(Consistency, WeightedRigidFitMatchesUmeyamaAndFollowsTheWeights) {
+  std::mt19937_64 rng(21);
+  std::normal_distribution<double> g(0.0, 1.0);
+  for (int trial = 0; trial < 20; ++trial) {
+    const int m = 3 + trial % 6;
+    Iso3 T = Iso3::Identity();
+    T.linear() = test::random_rotation(rng);
+    T.translation() = Vec3(g(rng), g(rng), g(rng)) * 500.0;
+    FitPoints src(3, kMaxMarkers), dst(3, kMaxMarkers);
+    FitWeights w{};
+    for (int i = 0; i < m; ++i) {
+      src.col(i) = Vec3(g(rng), g(rng), g(rng)) * 60.0;
+      dst.col(i) = T * Vec3(src.col(i)) + Vec3(g(rng), g(rng), g(rng)) * 0.1;
+      w[static_cast<std::size_t>(i)] = 1.0;
+    }
+    const RigidFit ref = fit_rigid(src, dst, m);
+    const RigidFit fit = fit_rigid_weighted(src, dst, w, m);
+    EXPECT_TRUE(fit.T_dst_src.isApprox(ref.T_dst_src, 1e-9));
+    EXPECT_NEAR(fit.sum_sq_mm2, ref.sum_sq_mm2, 1e-9);
+    EXPECT_NEAR(fit.T_dst_src.linear().determinant(), 1.0, 1e-12);
+    // Exact data on the first 3 columns with a huge weight, the others shifted by 5 mm:
+    // the fit follows the heavy columns.
+    for (int i = 0; i < m; ++i) {
+      const bool heavy = i < 3;
+      dst.col(i) = T * Vec3(src.col(i)) + (heavy ? Vec3::Zero() : Vec3(5.0, 0.0, 0.0));
+      w[static_cast<std::size_t>(i)] = heavy ? 1e6 : 1.0;
+    }
+    const RigidFit heavy = fit_rigid_weighted(src, dst, w, m);
+    EXPECT_LT((heavy.T_dst_src.translation() - T.translation()).norm(), 0.01);
+  }
+}
+
+TEST(Consistency, CoverageModeWeighsPartialMarkersAndNeedsARedundantFit) {
+  std::mt19937_64 rng(22);
+  std::normal_distribution<double> g(0.0, 1.0);
+  IdentifyConfig cfg;
+  cfg.temporal = false;
+  cfg.min_whole_markers = 0;
+  IdentifyConfig equal_cfg = cfg;  // partial markers weighted like whole ones
+  equal_cfg.partial_sigma_mm = 0.0;
+  int found_weighted = 0, kept_equal = 0;
+  for (int trial = 0; trial < 20; ++trial) {
+    OneBody b = make_body(rng, 5, 0.02);
+    // 2 whole markers (0, 2), 3 partial ones biased by 1 mm in random directions: no pose
+    // from whole markers, and an equal-weight fit cannot explain the biases.
+    for (int c : {1, 3, 4}) {
+      b.pts[static_cast<std::size_t>(c)].X_world += Vec3(g(rng), g(rng), g(rng)).normalized();
+      b.pts[static_cast<std::size_t>(c)].partial = true;
+    }
+    auto id = Identifier::create(b.set, cfg);
+    ASSERT_TRUE(id.ok());
+    BodyPoses out;
+    id->identify(b.pts.data(), 5, 0, out);
+    if (out.bodies[0].found && out.bodies[0].markers == 5) ++found_weighted;
+    auto equal = Identifier::create(b.set, equal_cfg);
+    ASSERT_TRUE(equal.ok());
+    equal->identify(b.pts.data(), 5, 0, out);
+    if (out.bodies[0].found && out.bodies[0].markers == 5) ++kept_equal;
+    // 2 whole + 1 partial = 3 markers: every bias of the partial one would pass into the
+    // pose unseen, so the pose is not reported even in coverage mode.
+    OneBody three = b;
+    three.pts.resize(3);
+    id->identify(three.pts.data(), 3, 1, out);
+    EXPECT_FALSE(out.bodies[0].found);
+  }
+  EXPECT_EQ(found_weighted, 20);
+  EXPECT_LT(kept_equal, 5);
+}
+
 TEST(Consistency, ConfigurationIsValidated) {
   IdentifyConfig cfg;
   cfg.point_sigma_mm = -1.0;
   EXPECT_NE(validate_config(cfg).error().message.find("point_sigma_mm"), std::string::npos);
+  cfg = IdentifyConfig{};
+  cfg.partial_sigma_mm = 0.1;  // below point_sigma_mm
+  EXPECT_NE(validate_config(cfg).error().message.find("partial_sigma_mm"), std::string::npos);
   cfg = IdentifyConfig{};
   cfg.consistency_confidence = 0.5;
   EXPECT_NE(validate_config(cfg).error().message.find("consistency_confidence"), std::string::npos);

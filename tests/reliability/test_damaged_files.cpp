@@ -153,6 +153,18 @@ INSTANTIATE_TEST_SUITE_P(Reliability, DamagedFile, ::testing::ValuesIn(kDamages)
                            return std::string(i.param.name);
                          });
 
+TEST(DamagedRecording, EndlessFileInPlaceOfAYamlIsAOneLineError) {
+  // targets.yaml as a link to /dev/zero: the reader stops at its size bound instead of
+  // growing until the process dies.
+  DamagedRecording d("targets_dev_zero");
+  const std::string path = path_of(d, Which::kTargets);
+  std::filesystem::remove(path);
+  std::filesystem::create_symlink("/dev/zero", path);
+  const test::RunResult r = d.track();
+  EXPECT_TRUE(test::is_one_line_error(r, path)) << r.output;
+  EXPECT_NE(r.output.find("larger than"), std::string::npos) << r.output;
+}
+
 TEST(DamagedRecording, OutputFolderThatIsAFileIsAOneLineError) {
   DamagedRecording d("out_is_file");
   test::write_file(d.out(), "not a folder");

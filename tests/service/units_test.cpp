@@ -1,12 +1,16 @@
 // Design: the systemd units of deploy/ pass `systemd-analyze verify` (which needs no
 // running systemd, but checks that ExecStart's binary exists): the templates are
 // instantiated the way deploy/CMakeLists.txt does at install, with the built `mocap` as
-// the binary, and verified together. Also checks the unit settings the service relies on.
+// the binary, and verified together. Also checks the unit settings the service relies on,
+// applies deploy/mocap.sysusers.conf to a scratch root with `systemd-sysusers --root`
+// (the shared user/group that iceoryx needs), and the Debian maintainer scripts.
 #include <gtest/gtest.h>
 
 #include <cstdlib>
 #include <filesystem>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include "tests/support/test_support.h"
 
@@ -71,6 +75,81 @@ TEST(SystemdUnits, ServiceSettings) {
     EXPECT_EQ(u->find("\nPrivateDevices="), std::string::npos);
     EXPECT_EQ(u->find("\nRemoveIPC="), std::string::npos);
   }
+}
+
+// The lines of a colon-separated database (/etc/passwd, /etc/group) as fields.
+std::vector<std::vector<std::string>> read_db(const std::string& path) {
+  std::vector<std::vector<std::string>> rows;
+  std::istringstream in(read_file(path));
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty()) continue;
+    std::vector<std::string> fields;
+    std::istringstream l(line);
+    for (std::string f; std::getline(l, f, ':');) fields.push_back(f);
+    if (line.back() == ':') fields.emplace_back();
+    rows.push_back(fields);
+  }
+  return rows;
+}
+
+const std::vector<std::string>* find_row(const std::vector<std::vector<std::string>>& db,
+                                         const std::string& name) {
+  for (const auto& r : db)
+    if (!r.empty() && r[0] == name) return &r;
+  return nullptr;
+}
+
+TEST(SystemdUnits, SysusersCreatesTheSharedUserAndGroup) {
+  if (std::system("command -v systemd-sysusers >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "systemd-sysusers not installed (Debian package 'systemd')";
+  TempDir root("sysusers");
+  std::filesystem::create_directories(root.file("etc"));
+  std::filesystem::create_directories(root.file("usr/lib/sysusers.d"));
+  std::filesystem::copy_file(source_dir() + "/deploy/mocap.sysusers.conf",
+                             root.file("usr/lib/sysusers.d/mocap.conf"));
+  ASSERT_EQ(std::system(("systemd-sysusers --root=" + root.path() + " >/dev/null 2>&1").c_str()),
+            0);
+  const auto passwd = read_db(root.file("etc/passwd"));
+  const auto group = read_db(root.file("etc/group"));
+  const auto* user = find_row(passwd, "mocap");
+  const auto* mocap_group = find_row(group, "mocap");
+  const auto* video = find_row(group, "video");
+  ASSERT_TRUE(user && user->size() == 7u) << read_file(root.file("etc/passwd"));
+  ASSERT_TRUE(mocap_group && mocap_group->size() == 4u) << read_file(root.file("etc/group"));
+  ASSERT_TRUE(video && video->size() == 4u) << read_file(root.file("etc/group"));
+  // The units run User=mocap Group=mocap: the user's primary group is `mocap`, a system id.
+  EXPECT_EQ((*user)[3], (*mocap_group)[2]);
+  EXPECT_LT(std::stoi((*user)[2]), 1000);
+  EXPECT_EQ((*user)[5], "/var/lib/mocap");  // StateDirectory=mocap
+  EXPECT_EQ((*user)[6], "/usr/sbin/nologin");
+  EXPECT_EQ((*video)[3], "mocap");  // camera device nodes
+}
+
+TEST(DebianPackage, MaintainerScriptsParseAndHandleBothUnits) {
+  const std::string dir = source_dir() + "/deploy/debian/";
+  for (const char* script : {"postinst.in", "prerm", "postrm"}) {
+    EXPECT_EQ(std::system(("sh -n " + dir + script).c_str()), 0) << script;
+    EXPECT_EQ(read_file(dir + script).rfind("#!/bin/sh\n", 0), 0u) << script;
+  }
+  for (const char* script : {"prerm", "postrm"})
+    EXPECT_NE(
+        std::filesystem::status(dir + script).permissions() & std::filesystem::perms::owner_exec,
+        std::filesystem::perms::none)
+        << script;
+  // Removal stops and disables every unit the package ships (no dangling enable links).
+  const std::string prerm = read_file(dir + "prerm");
+  for (const char* verb : {"systemctl stop ", "systemctl disable "}) {
+    const auto p = prerm.find(verb);
+    ASSERT_NE(p, std::string::npos) << verb;
+    const std::string line = prerm.substr(p, prerm.find('\n', p) - p);
+    for (const char* unit : {"mocap.service", "iox-roudi.service"})
+      EXPECT_NE(line.find(unit), std::string::npos) << line;
+  }
+  const std::string postinst = read_file(dir + "postinst.in");
+  EXPECT_NE(postinst.find("systemd-sysusers mocap.conf"), std::string::npos);
+  // Purge removes systemd's StateDirectory/LogsDirectory of mocap.service.
+  EXPECT_NE(read_file(dir + "postrm").find("rm -rf /var/lib/mocap /var/log/mocap"),
+            std::string::npos);
 }
 
 }  // namespace
