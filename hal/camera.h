@@ -15,6 +15,8 @@
 // writer: the capture thread; readable from any thread). A camera object is driven by
 // ONE thread (the capture thread); other stages reach its buffers through rings and
 // hand them back to that thread for release().
+// Backends that own their state derive from CameraBase (hal/camera_base.h), which keeps
+// name/state/config/notice/counters and the sequence-gap counting for them.
 #pragma once
 
 #include <cstdint>

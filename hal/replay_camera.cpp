@@ -44,8 +44,7 @@ CameraConfig ReplayCamera::native_config() const {
 }
 
 Expected<void> ReplayCamera::configure(const CameraConfig& want) {
-  if (state_ == CameraState::kStreaming)
-    return make_error(name_, "configure", "stop streaming first");
+  if (auto r = check_not_streaming(); !r) return r;
   const CameraModel& m = recording_->rig().cameras[static_cast<std::size_t>(camera_index_)];
   if (want.width != m.width || want.height != m.height) {
     return make_error(name_, "size",
@@ -53,11 +52,7 @@ Expected<void> ReplayCamera::configure(const CameraConfig& want) {
                           std::to_string(m.height) + ", configured " + std::to_string(want.width) +
                           "x" + std::to_string(want.height));
   }
-  if (want.buffer_count < 2 || want.buffer_count > kMaxBuffers) {
-    return make_error(name_, "buffer_count",
-                      "must be in 2.." + std::to_string(kMaxBuffers) + ", got " +
-                          std::to_string(want.buffer_count));
-  }
+  if (auto r = check_buffer_count(want.buffer_count, kMaxBuffers); !r) return r;
   config_ = want;
   notice_.clear();
   if (want.exposure_us > 0 || want.gain >= 0.0 || want.frame_rate_hz > 0.0) {
@@ -76,10 +71,7 @@ Expected<void> ReplayCamera::configure(const CameraConfig& want) {
 }
 
 Expected<void> ReplayCamera::start() {
-  if (state_ != CameraState::kConfigured) {
-    return make_error(name_, "start",
-                      std::string("camera is ") + to_string(state_) + ", not configured");
-  }
+  if (auto r = check_configured(); !r) return r;
   images_.assign(static_cast<std::size_t>(config_.buffer_count), Image{});
   for (Image& im : images_) {
     im.allocate(config_.width, config_.height, config_.format,
@@ -88,7 +80,7 @@ Expected<void> ReplayCamera::start() {
   held_.assign(images_.size(), false);
   next_ = 0;
   triggers_ = 0;
-  have_sequence_ = false;
+  reset_sequence();
   start_ns_ = monotonic_ns();
   state_ = CameraState::kStreaming;
   return {};
@@ -145,10 +137,7 @@ CameraStatus ReplayCamera::dequeue(Frame& out, int timeout_ms) noexcept {
     missing = true;
   }
   const auto sequence = static_cast<std::uint64_t>(entry.frame);
-  if (have_sequence_ && sequence > last_sequence_ + 1)
-    counters_.dropped.add(sequence - last_sequence_ - 1);
-  have_sequence_ = true;
-  last_sequence_ = sequence;
+  note_sequence(sequence);
   held_[b] = true;
   out.image = missing ? ImageView{} : image.view();
   out.sequence = sequence;

@@ -9,6 +9,8 @@
 // Trigger modes: kFreeRun (paced as above) and kSoftware (each trigger() releases
 // the next frame); kExternal falls back to kFreeRun with a notice. Exposure, gain and
 // frame rate are the recording's (notice).
+// State, config, notice, counters and the dropped-frame count from gaps in the
+// recording's frame numbers are kept by CameraBase (hal/camera_base.h).
 #pragma once
 
 #include <cstdint>
@@ -17,29 +19,24 @@
 #include <vector>
 
 #include "formats/recording.h"
-#include "hal/camera.h"
+#include "hal/camera_base.h"
 
 namespace mocap::hal {
 
 enum class ReplayPacing : std::uint8_t { kRecordedTiming, kAsFastAsPossible };
 
-class ReplayCamera final : public Camera {
+class ReplayCamera final : public CameraBase {
  public:
   // Setup. Both cameras of a rig can share one Recording.
   static Expected<std::unique_ptr<ReplayCamera>> open(std::shared_ptr<const Recording> recording,
                                                       int camera_index, ReplayPacing pacing);
 
-  const std::string& name() const noexcept override { return name_; }
-  CameraState state() const noexcept override { return state_; }
   Expected<void> configure(const CameraConfig& config) override;
   Expected<void> start() override;
   void stop() noexcept override;
   CameraStatus trigger() noexcept override;
   CameraStatus dequeue(Frame& out, int timeout_ms) noexcept override;
   CameraStatus release(const Frame& frame) noexcept override;
-  const CameraConfig& config() const noexcept override { return config_; }
-  const std::string& notice() const noexcept override { return notice_; }
-  const CameraCounters& counters() const noexcept override { return counters_; }
 
   // The configuration matching the recording (size of the rig's camera, 8-bit).
   CameraConfig native_config() const;
@@ -50,18 +47,11 @@ class ReplayCamera final : public Camera {
   std::shared_ptr<const Recording> recording_;
   int camera_index_ = 0;
   ReplayPacing pacing_;
-  std::string name_;
-  CameraState state_ = CameraState::kClosed;
-  CameraConfig config_;
-  std::string notice_;
-  CameraCounters counters_;
   std::vector<Image> images_;
   std::vector<bool> held_;
   std::size_t next_ = 0;        // index into recording_->frames()
   std::uint64_t triggers_ = 0;  // software triggers not yet consumed
   std::int64_t start_ns_ = 0;
-  bool have_sequence_ = false;
-  std::uint64_t last_sequence_ = 0;
 };
 
 }  // namespace mocap::hal

@@ -1,13 +1,14 @@
 // Design: see sim_camera.h. Rendering happens once in SimFrameLoop::render (both cameras
-// on two threads); the hot calls only index the pre-rendered images and read the
-// trigger stamps. Waiting (no trigger yet, or a free-run frame not yet due) sleeps on
-// CLOCK_MONOTONIC with absolute deadlines in steps of at most 1 ms.
+// of each frame on two threads, sim::StereoRender); the hot calls only index the
+// pre-rendered images and read the trigger stamps. Waiting (no trigger yet, or a
+// free-run frame not yet due) sleeps on CLOCK_MONOTONIC with absolute deadlines in
+// steps of at most 1 ms.
 #include "hal/sim_camera.h"
 
 #include <algorithm>
 #include <ctime>
-#include <thread>
 
+#include "sim/frame_writer.h"
 #include "sim/motion.h"
 #include "sim/render.h"
 
@@ -25,13 +26,7 @@ Expected<std::shared_ptr<const SimFrameLoop>> SimFrameLoop::render(const sim::Si
   }
   auto scene = sim::make_scene(options);
   if (!scene) return scene.error();
-  sim::MotionSpec spec;
-  spec.kind = options.motion;
-  spec.frames = options.frames;
-  spec.fps = options.fps;
-  spec.poses = options.poses;
-  spec.seed = options.seed;
-  auto plan = sim::plan_motion(*scene, spec);
+  auto plan = sim::plan_motion(*scene, sim::motion_spec(options));
   if (!plan) return plan.error();
 
   std::shared_ptr<SimFrameLoop> loop(new SimFrameLoop());
@@ -48,28 +43,12 @@ Expected<std::shared_ptr<const SimFrameLoop>> SimFrameLoop::render(const sim::Si
     loop->states_.push_back(std::move(st));
     for (int c = 0; c < 2; ++c) loop->images_.push_back(sim::make_camera_image(sc, c));
   }
-  auto ws0 = sim::RenderWorkspace::create(sc);
-  if (!ws0) return ws0.error();
-  sim::RenderWorkspace ws1 = *ws0;
-  std::array<sim::RenderWorkspace*, 2> ws = {&*ws0, &ws1};
-  std::array<bool, 2> ok = {true, true};
-  auto job = [&](int c) {
-    for (std::size_t f = 0; f < n; ++f) {
-      ok[static_cast<std::size_t>(c)] =
-          ok[static_cast<std::size_t>(c)] &&
-          sim::render(sc, loop->states_[f], c, *ws[static_cast<std::size_t>(c)],
-                      loop->images_[f * 2 + static_cast<std::size_t>(c)]);
-    }
-  };
-  if (options.threads >= 2) {
-    std::thread t1(job, 1);
-    job(0);
-    t1.join();
-  } else {
-    job(0);
-    job(1);
+  auto stereo = sim::StereoRender::create(sc, options.threads);
+  if (!stereo) return stereo.error();
+  for (std::size_t f = 0; f < n; ++f) {
+    if (!stereo->render(loop->states_[f], {&loop->images_[f * 2], &loop->images_[f * 2 + 1]}))
+      return make_error("sim camera", "render", "rendering a loop frame failed");
   }
-  if (!ok[0] || !ok[1]) return make_error("sim camera", "render", "rendering a loop frame failed");
   return std::shared_ptr<const SimFrameLoop>(std::move(loop));
 }
 
@@ -137,8 +116,7 @@ CameraConfig SimCamera::native_config() const {
 }
 
 Expected<void> SimCamera::configure(const CameraConfig& want) {
-  if (state_ == CameraState::kStreaming)
-    return make_error(name_, "configure", "stop streaming first");
+  if (auto r = check_not_streaming(); !r) return r;
   const Image& im = trigger_->loop().image(0, camera_index_);
   if (want.width != im.width() || want.height != im.height()) {
     return make_error(name_, "size",
@@ -151,11 +129,7 @@ Expected<void> SimCamera::configure(const CameraConfig& want) {
                       std::string("the simulated camera renders ") +
                           (im.format() == PixelFormat::kMono8 ? "8" : "16") + "-bit images");
   }
-  if (want.buffer_count < 2 || want.buffer_count > kMaxBuffers) {
-    return make_error(name_, "buffer_count",
-                      "must be in 2.." + std::to_string(kMaxBuffers) + ", got " +
-                          std::to_string(want.buffer_count));
-  }
+  if (auto r = check_buffer_count(want.buffer_count, kMaxBuffers); !r) return r;
   if (want.trigger == TriggerMode::kFreeRun && !(want.frame_rate_hz > 0.0)) {
     return make_error(name_, "frame_rate_hz", "free-run needs a rate > 0");
   }
@@ -171,10 +145,7 @@ Expected<void> SimCamera::configure(const CameraConfig& want) {
 }
 
 Expected<void> SimCamera::start() {
-  if (state_ != CameraState::kConfigured) {
-    return make_error(name_, "start",
-                      std::string("camera is ") + to_string(state_) + ", not configured");
-  }
+  if (auto r = check_configured(); !r) return r;
   held_.assign(static_cast<std::size_t>(config_.buffer_count), 0);
   held_count_ = 0;
   next_ = config_.trigger == TriggerMode::kFreeRun ? 0 : trigger_->count();

@@ -17,6 +17,8 @@
 //                  (kNoBuffer beyond). trigger/dequeue/release are noexcept and
 //                  allocation-free. A camera that falls more than kTriggerRing triggers
 //                  behind skips ahead (counted in `dropped`).
+//                  State, config, notice and counters are kept by CameraBase
+//                  (hal/camera_base.h).
 #pragma once
 
 #include <array>
@@ -27,7 +29,7 @@
 #include <vector>
 
 #include "core/image.h"
-#include "hal/camera.h"
+#include "hal/camera_base.h"
 #include "sim/scene.h"
 #include "sim/simulate.h"
 
@@ -83,22 +85,17 @@ class SimTrigger {
   std::atomic<std::uint64_t> count_{0};
 };
 
-class SimCamera final : public Camera {
+class SimCamera final : public CameraBase {
  public:
   static Expected<std::unique_ptr<SimCamera>> open(std::shared_ptr<SimTrigger> trigger,
                                                    int camera_index);
 
-  const std::string& name() const noexcept override { return name_; }
-  CameraState state() const noexcept override { return state_; }
   Expected<void> configure(const CameraConfig& config) override;
   Expected<void> start() override;
   void stop() noexcept override;
   CameraStatus trigger() noexcept override;
   CameraStatus dequeue(Frame& out, int timeout_ms) noexcept override;
   CameraStatus release(const Frame& frame) noexcept override;
-  const CameraConfig& config() const noexcept override { return config_; }
-  const std::string& notice() const noexcept override { return notice_; }
-  const CameraCounters& counters() const noexcept override { return counters_; }
 
   // The scene camera's size, 8-bit, software trigger for camera 0 and external
   // (slaved) for camera 1, at the loop's frame rate.
@@ -109,11 +106,6 @@ class SimCamera final : public Camera {
 
   std::shared_ptr<SimTrigger> trigger_;
   int camera_index_ = 0;
-  std::string name_;
-  CameraState state_ = CameraState::kClosed;
-  CameraConfig config_;
-  std::string notice_;
-  CameraCounters counters_;
   std::vector<std::uint8_t> held_;  // per buffer: held by the caller
   std::uint32_t held_count_ = 0;
   std::uint64_t next_ = 0;  // next sequence to deliver

@@ -50,6 +50,15 @@ std::string normalised(const char* name, std::size_t max_len) {
 
 bool contains(const std::string& s, const char* word) { return s.find(word) != std::string::npos; }
 
+// A capture buffer of the mmap streaming I/O (every buffer this backend queues).
+v4l2_buffer mmap_buffer(std::uint32_t index = 0) noexcept {
+  v4l2_buffer b{};
+  b.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+  b.memory = V4L2_MEMORY_MMAP;
+  b.index = index;
+  return b;
+}
+
 }  // namespace
 
 Expected<std::unique_ptr<V4l2Camera>> V4l2Camera::open(const std::string& path,
@@ -72,7 +81,7 @@ Expected<std::unique_ptr<V4l2Camera>> V4l2Camera::open(const std::string& path,
 }
 
 V4l2Camera::V4l2Camera(std::string path, std::shared_ptr<V4l2Sys> sys, int fd)
-    : path_(std::move(path)), sys_(std::move(sys)), fd_(fd) {}
+    : CameraBase(std::move(path)), sys_(std::move(sys)), fd_(fd) {}
 
 V4l2Camera::~V4l2Camera() {
   stop();
@@ -88,7 +97,7 @@ int V4l2Camera::xioctl(unsigned long request, void* arg) noexcept {
 }
 
 Error V4l2Camera::sys_error(const std::string& what, int err) const {
-  return make_error(path_, what, std::strerror(err));
+  return make_error(name_, what, std::strerror(err));
 }
 
 Expected<V4l2Camera::Control> V4l2Camera::query_control(std::uint32_t id, const char* label) {
@@ -124,20 +133,15 @@ Expected<void> V4l2Camera::set_control(const Control& c, std::int32_t value, con
 }
 
 Expected<void> V4l2Camera::configure(const CameraConfig& want) {
-  if (state_ == CameraState::kStreaming)
-    return make_error(path_, "configure", "stop streaming first");
+  if (auto r = check_not_streaming(); !r) return r;
   if (state_ == CameraState::kError)
-    return make_error(path_, "configure", "device failed: reopen it");
+    return make_error(name_, "configure", "device failed: reopen it");
   if (want.width <= 0 || want.height <= 0) {
     return make_error(
-        path_, "size",
+        name_, "size",
         "must be positive, got " + std::to_string(want.width) + "x" + std::to_string(want.height));
   }
-  if (want.buffer_count < 2 || want.buffer_count > kMaxBuffers) {
-    return make_error(path_, "buffer_count",
-                      "must be in 2.." + std::to_string(kMaxBuffers) + ", got " +
-                          std::to_string(want.buffer_count));
-  }
+  if (auto r = check_buffer_count(want.buffer_count, kMaxBuffers); !r) return r;
   state_ = CameraState::kClosed;
   notice_.clear();
   config_ = want;
@@ -166,7 +170,7 @@ Expected<void> V4l2Camera::configure_format(const CameraConfig& want) {
   const auto want_w = static_cast<std::uint32_t>(want.width),
              want_h = static_cast<std::uint32_t>(want.height);
   if (p.pixelformat != want_fourcc || p.width != want_w || p.height != want_h) {
-    return make_error(path_, "format",
+    return make_error(name_, "format",
                       "driver offers " + size_text(p.width, p.height) + " " +
                           fourcc_name(p.pixelformat) + " for the requested " +
                           size_text(want_w, want_h) + " " + fourcc_name(want_fourcc));
@@ -175,7 +179,7 @@ Expected<void> V4l2Camera::configure_format(const CameraConfig& want) {
       p.width * static_cast<std::uint32_t>(bytes_per_pixel(want.format));
   const std::uint32_t stride = p.bytesperline == 0 ? row_bytes : p.bytesperline;
   if (stride < row_bytes) {
-    return make_error(path_, "format",
+    return make_error(name_, "format",
                       "bytesperline " + std::to_string(stride) + " < width * bytes per pixel " +
                           std::to_string(row_bytes));
   }
@@ -184,7 +188,7 @@ Expected<void> V4l2Camera::configure_format(const CameraConfig& want) {
   frame_bytes_ = stride * (p.height - 1) + row_bytes;
   if (p.sizeimage != 0 && p.sizeimage < frame_bytes_) {
     return make_error(
-        path_, "format",
+        name_, "format",
         "sizeimage " + std::to_string(p.sizeimage) + " < " + std::to_string(frame_bytes_));
   }
   return {};
@@ -222,11 +226,11 @@ Expected<void> V4l2Camera::configure_exposure_gain(const CameraConfig& want) {
     auto exposure = query_control(V4L2_CID_EXPOSURE_ABSOLUTE, "exposure");
     if (!exposure) return exposure.error();
     if (!exposure->present)
-      return make_error(path_, "exposure_us",
+      return make_error(name_, "exposure_us",
                         "the device has no V4L2_CID_EXPOSURE_ABSOLUTE control");
     const long units = std::lround(want.exposure_us / 100.0);  // V4L2: 100 us units
     if (units < exposure->minimum || units > exposure->maximum) {
-      return make_error(path_, "exposure_us",
+      return make_error(name_, "exposure_us",
                         std::to_string(want.exposure_us) + " outside the device's range " +
                             std::to_string(exposure->minimum * 100) + ".." +
                             std::to_string(static_cast<long>(exposure->maximum) * 100) + " us");
@@ -239,10 +243,10 @@ Expected<void> V4l2Camera::configure_exposure_gain(const CameraConfig& want) {
   if (want.gain >= 0.0) {
     auto gain = query_control(V4L2_CID_GAIN, "gain");
     if (!gain) return gain.error();
-    if (!gain->present) return make_error(path_, "gain", "the device has no V4L2_CID_GAIN control");
+    if (!gain->present) return make_error(name_, "gain", "the device has no V4L2_CID_GAIN control");
     const long value = std::lround(want.gain);
     if (value < gain->minimum || value > gain->maximum) {
-      return make_error(path_, "gain",
+      return make_error(name_, "gain",
                         std::to_string(value) + " outside the device's range " +
                             std::to_string(gain->minimum) + ".." + std::to_string(gain->maximum));
     }
@@ -298,7 +302,7 @@ Expected<void> V4l2Camera::configure_trigger(const CameraConfig& want) {
   if (!usable) {
     config_.trigger = TriggerMode::kFreeRun;
     trigger_button_ = Control{};
-    notice_ += (notice_.empty() ? "" : "; ") + path_ + ": trigger: no " +
+    notice_ += (notice_.empty() ? "" : "; ") + name_ + ": trigger: no " +
                (want.trigger == TriggerMode::kSoftware ? "software-trigger" : "trigger-mode") +
                " control: camera free-runs (pair frames by timestamp)";
     return {};
@@ -306,70 +310,50 @@ Expected<void> V4l2Camera::configure_trigger(const CameraConfig& want) {
   std::int32_t achieved = 0;
   if (auto r = set_control(mode, mode_value, "trigger", achieved); !r) return r;
   if (achieved != mode_value)
-    return make_error(path_, "trigger", "the driver did not accept trigger mode");
+    return make_error(name_, "trigger", "the driver did not accept trigger mode");
   return {};
 }
 
 Expected<void> V4l2Camera::start() {
-  if (state_ != CameraState::kConfigured) {
-    return make_error(path_, "start",
-                      std::string("camera is ") + to_string(state_) + ", not configured");
-  }
+  if (auto r = check_configured(); !r) return r;
   v4l2_requestbuffers req{};
   req.count = static_cast<std::uint32_t>(config_.buffer_count);
   req.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
   req.memory = V4L2_MEMORY_MMAP;
   if (xioctl(VIDIOC_REQBUFS, &req) < 0) return sys_error("start: VIDIOC_REQBUFS", errno);
   if (req.count < 2 || req.count > kMaxBuffers) {
-    return make_error(path_, "start",
+    return make_error(name_, "start",
                       "driver granted " + std::to_string(req.count) + " buffers (need 2.." +
                           std::to_string(kMaxBuffers) + ")");
   }
+  // A failed call: undo the mapping, then the error of the call's errno.
+  auto fail_start = [this](const char* what) {
+    const int e = errno;
+    unmap_all();
+    return sys_error(what, e);
+  };
   buffers_.assign(req.count, Buffer{});
   for (std::uint32_t i = 0; i < req.count; ++i) {
-    v4l2_buffer b{};
-    b.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-    b.memory = V4L2_MEMORY_MMAP;
-    b.index = i;
-    if (xioctl(VIDIOC_QUERYBUF, &b) < 0) {
-      const int e = errno;
-      unmap_all();
-      return sys_error("start: VIDIOC_QUERYBUF", e);
-    }
+    v4l2_buffer b = mmap_buffer(i);
+    if (xioctl(VIDIOC_QUERYBUF, &b) < 0) return fail_start("start: VIDIOC_QUERYBUF");
     if (b.length < frame_bytes_) {
       unmap_all();
-      return make_error(path_, "start",
+      return make_error(name_, "start",
                         "buffer of " + std::to_string(b.length) + " bytes < frame of " +
                             std::to_string(frame_bytes_));
     }
     void* p = sys_->mmap(b.length, PROT_READ | PROT_WRITE, MAP_SHARED, fd_,
                          static_cast<off_t>(b.m.offset));
-    if (p == MAP_FAILED) {
-      const int e = errno;
-      unmap_all();
-      return sys_error("start: mmap", e);
-    }
+    if (p == MAP_FAILED) return fail_start("start: mmap");
     buffers_[i] = Buffer{p, b.length, false};
   }
   for (std::uint32_t i = 0; i < req.count; ++i) {
-    v4l2_buffer b{};
-    b.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-    b.memory = V4L2_MEMORY_MMAP;
-    b.index = i;
-    if (xioctl(VIDIOC_QBUF, &b) < 0) {
-      const int e = errno;
-      unmap_all();
-      return sys_error("start: VIDIOC_QBUF", e);
-    }
+    v4l2_buffer b = mmap_buffer(i);
+    if (xioctl(VIDIOC_QBUF, &b) < 0) return fail_start("start: VIDIOC_QBUF");
   }
   int type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-  if (xioctl(VIDIOC_STREAMON, &type) < 0) {
-    const int e = errno;
-    unmap_all();
-    return sys_error("start: VIDIOC_STREAMON", e);
-  }
-  have_sequence_ = false;
-  last_sequence_ = 0;
+  if (xioctl(VIDIOC_STREAMON, &type) < 0) return fail_start("start: VIDIOC_STREAMON");
+  reset_sequence();
   state_ = CameraState::kStreaming;
   return {};
 }
@@ -428,24 +412,15 @@ CameraStatus V4l2Camera::dequeue(Frame& out, int timeout_ms) noexcept {
   }
   if (pr < 0) return fail(errno);
   // POLLERR/POLLHUP without data: DQBUF's errno says whether the device is gone.
-  v4l2_buffer b{};
-  b.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-  b.memory = V4L2_MEMORY_MMAP;
+  v4l2_buffer b = mmap_buffer();
   if (xioctl(VIDIOC_DQBUF, &b) < 0) return fail(errno);
   if (b.index >= buffers_.size()) {
     counters_.errors.add();
     return CameraStatus::kIoError;
   }
   // Sequence: the driver's 32-bit counter, extended across wrap-around.
-  const std::uint64_t sequence =
-      have_sequence_
-          ? last_sequence_ +
-                static_cast<std::uint32_t>(b.sequence - static_cast<std::uint32_t>(last_sequence_))
-          : b.sequence;
-  if (have_sequence_ && sequence > last_sequence_ + 1)
-    counters_.dropped.add(sequence - last_sequence_ - 1);
-  have_sequence_ = true;
-  last_sequence_ = sequence;
+  const std::uint64_t sequence = extend_sequence32(b.sequence);
+  note_sequence(sequence);
 
   const bool short_frame = b.bytesused != 0 && b.bytesused < frame_bytes_;
   if ((b.flags & V4L2_BUF_FLAG_ERROR) || short_frame) {
@@ -479,10 +454,7 @@ CameraStatus V4l2Camera::release(const Frame& frame) noexcept {
     counters_.errors.add();
     return CameraStatus::kInvalidBuffer;
   }
-  v4l2_buffer b{};
-  b.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-  b.memory = V4L2_MEMORY_MMAP;
-  b.index = frame.buffer_index;
+  v4l2_buffer b = mmap_buffer(frame.buffer_index);
   if (xioctl(VIDIOC_QBUF, &b) < 0) return fail(errno);
   buffers_[frame.buffer_index].held = false;
   return CameraStatus::kOk;

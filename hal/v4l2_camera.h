@@ -15,6 +15,8 @@
 //              and gaps are counted as dropped; buffer timestamps are CLOCK_MONOTONIC
 //   release  : VIDIOC_QBUF of the frame's buffer
 // ENODEV anywhere after open moves the camera to kError (device unplugged).
+// name() is the device path; state, config, notice, counters and the dropped-frame
+// count from sequence gaps are kept by CameraBase (hal/camera_base.h).
 #pragma once
 
 #include <cstdint>
@@ -22,29 +24,24 @@
 #include <string>
 #include <vector>
 
-#include "hal/camera.h"
+#include "hal/camera_base.h"
 #include "hal/v4l2_sys.h"
 
 namespace mocap::hal {
 
-class V4l2Camera final : public Camera {
+class V4l2Camera final : public CameraBase {
  public:
   // Setup. Error "<path>: cannot open: No such file or directory" when absent.
   static Expected<std::unique_ptr<V4l2Camera>> open(const std::string& path,
                                                     std::shared_ptr<V4l2Sys> sys = real_v4l2_sys());
   ~V4l2Camera() override;
 
-  const std::string& name() const noexcept override { return path_; }
-  CameraState state() const noexcept override { return state_; }
   Expected<void> configure(const CameraConfig& config) override;
   Expected<void> start() override;
   void stop() noexcept override;
   CameraStatus trigger() noexcept override;
   CameraStatus dequeue(Frame& out, int timeout_ms) noexcept override;
   CameraStatus release(const Frame& frame) noexcept override;
-  const CameraConfig& config() const noexcept override { return config_; }
-  const std::string& notice() const noexcept override { return notice_; }
-  const CameraCounters& counters() const noexcept override { return counters_; }
 
  private:
   struct Buffer {
@@ -72,19 +69,12 @@ class V4l2Camera final : public Camera {
   void unmap_all() noexcept;
   CameraStatus fail(int err) noexcept;  // counts and maps an errno of a hot-path call
 
-  std::string path_;
   std::shared_ptr<V4l2Sys> sys_;
   int fd_ = -1;
-  CameraState state_ = CameraState::kClosed;
-  CameraConfig config_;
-  std::string notice_;
-  CameraCounters counters_;
   int stride_bytes_ = 0;
   std::uint32_t frame_bytes_ = 0;
   Control trigger_button_;
   std::vector<Buffer> buffers_;
-  bool have_sequence_ = false;
-  std::uint64_t last_sequence_ = 0;
 };
 
 }  // namespace mocap::hal

@@ -13,13 +13,15 @@
 // Drop policy (the capture never blocks): each consumer drains its input and works on
 // the NEWEST item, returning the older ones (counted as skipped); a producer whose
 // consumer has stalled long enough to hold every slot drops the incoming item (counted).
-// Pairing: FramePairer by trigger sequence (tolerance 0; unmatched frames counted).
-// Pairing: by trigger sequence (tolerance 0) or, for free-running cameras, by sensor
-// timestamp within PipelineOptions::pair_tolerance_us.
+// Pairing: hal::FramePairer by trigger sequence (tolerance 0) or, for free-running
+// cameras, by sensor timestamp within PipelineOptions::pair_tolerance_us (unmatched
+// frames counted).
 // Latency: every sample is measured from the frame's trigger timestamp (Frame.timestamp_ns)
 // on CLOCK_MONOTONIC: detect done, identify done, published (end to end), into
 // LatencyHistograms that any thread may read while the pipeline runs.
 // Health: health(), frames_published() and last_publish_ns() may be read from any thread.
+// Sources: pipeline.cpp (setup, start/stop), capture_stage.cpp, processing_stages.cpp
+// (detect, identify, publish loops), pipeline_stats.cpp (health, stats).
 #pragma once
 
 #include <array>
@@ -41,7 +43,9 @@
 #include "pipeline/doorbell.h"
 #include "pipeline/joints_sink.h"
 #include "pipeline/latency_histogram.h"
+#include "pipeline/stage_counters.h"
 #include "pipeline/stage_table.h"
+#include "pipeline/timestamp_check.h"
 #include "track/frame_processor.h"
 
 namespace mocap::pipeline {
@@ -105,6 +109,11 @@ struct PipelineHealth {
   double max_us = 0.0;  // trigger-to-publish max since start()
   std::int64_t last_publish_ns = 0;           // CLOCK_MONOTONIC; 0: nothing published yet
   std::int64_t camera_silent_ms[2] = {0, 0};  // time since camera c last delivered a frame
+  // Per camera: frames whose blobs did not all fit (an image full of blobs: the detector's
+  // run or blob capacity overflowed; detect_camN_frames_overflow) and camera clock steps
+  // (timestamp_backwards_camN + timestamp_jumps_camN).
+  std::uint64_t detect_overflow_frames[2] = {0, 0};
+  std::uint64_t timestamp_steps[2] = {0, 0};
 };
 
 struct PipelineStats {
@@ -178,25 +187,44 @@ class Pipeline {
     rt::Counter trigger_late_max_us;  // latest trigger vs its deadline
     rt::Counter capture_ring_full[2], release_errors;
     rt::Counter camera_max_silence_us[2];  // longest interval without a frame (a stall)
+    // Camera clock steps (TimestampCheck verdicts), capture thread.
+    rt::Counter timestamp_backwards[2], timestamp_jumps[2];
     rt::Counter detect_skipped[2], detect_no_slot[2];
     rt::Counter frames_unpaired;  // sequences that never formed a pair (identify)
     rt::Counter identify_skipped, identify_no_slot;
     rt::Counter frames_without_result;  // processed, but not every body found
     rt::Counter publish_skipped, sink_failures;
+    // The per-frame libraries' own counters (stage_counters.h), written every frame:
+    // each writer thread's on cache lines of its own (no false sharing between cores).
+    struct alignas(64) DetectLibrary {  // detect c
+      DetectorMirror detector;
+      rt::Counter blobs;  // blobs handed to identify
+    };
+    DetectLibrary detect_library[2];
+    struct alignas(64) IdentifyLibrary {  // identify
+      StereoMirror stereo;
+      IdentifyMirror identify;
+    };
+    IdentifyLibrary identify_library;
   };
   struct Latencies {
     LatencyHistogram detect[2], detect_work[2], identify, identify_work, publish, sink_work;
   };
 
+  static constexpr std::int64_t kIdleWaitNs = 10'000'000;  // stages re-check stop this often
+  static constexpr std::int64_t kLockstepTimeoutNs = 1'000'000'000;
+
   Pipeline(FrameProcessor processor, std::array<hal::Camera*, 2> cameras,
            std::vector<JointsSink*> sinks, const PipelineOptions& options);
 
+  // The stage loops (capture_stage.cpp, processing_stages.cpp).
   void capture_loop() noexcept;
   void detect_loop(int camera) noexcept;
   void identify_loop() noexcept;
   void publish_loop() noexcept;
   void release_returned() noexcept;
-  void on_frame_received(int camera, std::uint64_t sequence) noexcept;
+  // trigger_ns: host time of the last software trigger (0: free-running cameras).
+  void on_frame_received(int camera, const hal::Frame& frame, std::int64_t trigger_ns) noexcept;
   void retire(std::uint64_t sequence) noexcept;
   bool stopping() const noexcept { return stop_.load(std::memory_order_acquire); }
   void drain_after_join() noexcept;
@@ -216,6 +244,7 @@ class Pipeline {
   std::unique_ptr<FrameOutput> out_;
   std::unique_ptr<Counters> counters_;
   std::unique_ptr<Latencies> lat_;
+  std::array<TimestampCheck, 2> clock_checks_{};  // capture thread (set as its loop starts)
   std::array<Doorbell, kStageCount> bells_{};
   std::vector<rt::RtThread> threads_;
   std::int64_t start_ns_ = 0, stop_ns_ = 0;

@@ -34,15 +34,20 @@ std::string format_pipeline_stats(const PipelineStats& s) {
 
 std::string format_progress_line(double elapsed_s, double interval_s, const LatencyStats& e2e,
                                  const PipelineHealth& h) {
-  char line[320];
+  char line[400];
   std::snprintf(
       line, sizeof line,
       "t=%.1fs fps=%.1f e2e(last %.1fs, %llu) p50=%.0f p99=%.0f p99.9=%.0f max=%.0f us "
-      "published=%llu dropped=%llu cam silent=%lld/%lld ms",
+      "published=%llu dropped=%llu cam silent=%lld/%lld ms blob overflow=%llu/%llu "
+      "clock steps=%llu/%llu",
       elapsed_s, h.fps, interval_s, static_cast<unsigned long long>(e2e.count), e2e.p50_us,
       e2e.p99_us, e2e.p999_us, e2e.max_us, static_cast<unsigned long long>(h.frames_published),
       static_cast<unsigned long long>(h.frames_dropped),
-      static_cast<long long>(h.camera_silent_ms[0]), static_cast<long long>(h.camera_silent_ms[1]));
+      static_cast<long long>(h.camera_silent_ms[0]), static_cast<long long>(h.camera_silent_ms[1]),
+      static_cast<unsigned long long>(h.detect_overflow_frames[0]),
+      static_cast<unsigned long long>(h.detect_overflow_frames[1]),
+      static_cast<unsigned long long>(h.timestamp_steps[0]),
+      static_cast<unsigned long long>(h.timestamp_steps[1]));
   return line;
 }
 

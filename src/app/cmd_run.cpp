@@ -7,7 +7,8 @@
 // publishers of pipeline/publish when they are built in (MOCAP_HAVE_PUBLISH). --duration, SIGINT or
 // SIGTERM stop it cleanly (the signal handler only sets an atomic flag); it then prints the latency
 // statistics and, with --stats, writes them as JSON. While running, every --stats-interval
-// seconds one progress line goes to stderr (pipeline::format_progress_line).
+// seconds one progress line goes to stderr (pipeline::format_progress_line); at the end a
+// warning line per camera whose images overflowed the detector or whose clock stepped.
 // --config FILE runs the cameras, tracker, stage table and outputs of a configuration
 // file (docs/operations.md; flags given on the command line override it);
 // --check-config FILE only validates one. Under systemd (NOTIFY_SOCKET) the supervisor of
@@ -182,6 +183,24 @@ void supervise(const pipeline::Pipeline& pipe, const RunArgs& a, service::Superv
   }
 }
 
+// One warning line per camera whose images overflowed the detector or whose clock
+// stepped (the counters say how often; docs/pipeline.md).
+void report_camera_faults(const pipeline::PipelineHealth& h) {
+  for (int c = 0; c < 2; ++c) {
+    const auto i = static_cast<std::size_t>(c);
+    if (h.detect_overflow_frames[i] > 0)
+      std::fprintf(stderr,
+                   "mocap run: warning: camera %d: %llu frames overflowed the detector's run "
+                   "or blob capacity (detect_cam%d_frames_overflow)\n",
+                   c, static_cast<unsigned long long>(h.detect_overflow_frames[i]), c);
+    if (h.timestamp_steps[i] > 0)
+      std::fprintf(stderr,
+                   "mocap run: warning: camera %d: its clock stepped %llu times "
+                   "(timestamp_backwards_cam%d, timestamp_jumps_cam%d)\n",
+                   c, static_cast<unsigned long long>(h.timestamp_steps[i]), c, c);
+  }
+}
+
 int run_live(const RunArgs& a) {
   auto udp = parse_host_port(a.udp);
   if (!udp) return fail(udp.error().message);
@@ -239,6 +258,7 @@ int run_live(const RunArgs& a) {
   (*pipe)->stop();
   const pipeline::PipelineStats st = (*pipe)->stats();
   std::fputs(pipeline::format_pipeline_stats(st).c_str(), stdout);
+  report_camera_faults((*pipe)->health());
   if (!a.stats.empty()) {
     if (auto r = pipeline::write_pipeline_stats_json(a.stats, st); !r)
       return fail(r.error().message);

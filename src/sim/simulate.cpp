@@ -1,15 +1,14 @@
 // Design: the recording writer. Per frame: forward kinematics, one render per camera
-// (camera 1 on a second thread with its own workspace when threads = 2; results are
-// identical either way because every random draw is keyed by seed, frame and camera),
-// the PGM files, then the ground-truth rows. Files are written with mocap_formats.
+// (StereoRender, frame_writer.h: camera 1 on a second thread with its own workspace
+// when threads = 2; results are identical either way because every random draw is
+// keyed by seed, frame and camera), the PGM files, then the ground-truth rows. Files
+// are written with mocap_formats.
 #include "sim/simulate.h"
 
 #include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
-#include <thread>
 
 #include "core/rotation.h"
 #include "formats/csv_outputs.h"
@@ -18,6 +17,7 @@
 #include "formats/recording.h"
 #include "formats/rig_yaml.h"
 #include "formats/targets_yaml.h"
+#include "sim/frame_writer.h"
 #include "sim/render.h"
 #include "sim/sim_rng.h"
 
@@ -26,16 +26,6 @@ namespace {
 
 constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
 
-Expected<void> make_dir(const std::string& path) {
-  std::error_code ec;
-  std::filesystem::create_directories(path, ec);
-  if (ec || !std::filesystem::is_directory(path, ec)) {
-    return make_error(path, "",
-                      "cannot create directory" + (ec ? ": " + ec.message() : std::string()));
-  }
-  return {};
-}
-
 Quat hinge_zero(const JointSpec& joint) {
   for (const auto& [key, values] : joint.extra) {
     if (key == "zero_q_parent_child" && values.size() == 4) {
@@ -43,29 +33,6 @@ Quat hinge_zero(const JointSpec& joint) {
     }
   }
   return Quat::Identity();
-}
-
-struct CameraResult {
-  std::vector<MarkerView> markers;
-  std::vector<StrayView> strays;
-  bool ok = false;
-  Error error{};
-};
-
-void render_camera(const SimScene& scene, const SceneState& state, int cam, RenderWorkspace& ws,
-                   Image& img, const std::string& path, CameraResult& result) {
-  result.ok = render(scene, state, cam, ws, img);
-  if (!result.ok) {
-    result.error = make_error("simulate", "render", "camera " + std::to_string(cam) + " failed");
-    return;
-  }
-  result.markers.assign(ws.markers.begin(), ws.markers.end());
-  result.strays.assign(ws.strays.begin(), ws.strays.begin() + ws.stray_count);
-  auto w = write_pgm(path, img.view());
-  if (!w) {
-    result.ok = false;
-    result.error = w.error();
-  }
 }
 
 const char* stray_name(StrayKind k) { return k == StrayKind::kGlint ? "glint" : "streak"; }
@@ -81,6 +48,16 @@ Vec3 joint_angles_rad(const JointSpec& joint, const Iso3& T_world_parent,
   const double angle =
       std::atan2(0.5 * v.dot(joint.axis_parent.normalized()), 0.5 * (Rd.trace() - 1.0));
   return Vec3(angle, 0.0, 0.0);
+}
+
+MotionSpec motion_spec(const SimOptions& options) {
+  MotionSpec spec;
+  spec.kind = options.motion;
+  spec.frames = options.frames;
+  spec.fps = options.fps;
+  spec.poses = options.poses;
+  spec.seed = options.seed;
+  return spec;
 }
 
 std::uint64_t frame_noise_key(std::uint64_t seed, std::int64_t frame) noexcept {
@@ -115,28 +92,16 @@ Expected<SimSummary> write_simulated_recording(const SimOptions& options, const 
   auto scene_r = make_scene(options);
   if (!scene_r) return scene_r.error();
   const SimScene& scene = *scene_r;
-  MotionSpec spec;
-  spec.kind = options.motion;
-  spec.frames = options.frames;
-  spec.fps = options.fps;
-  spec.poses = options.poses;
-  spec.seed = options.seed;
-  auto plan_r = plan_motion(scene, spec);
+  auto plan_r = plan_motion(scene, motion_spec(options));
   if (!plan_r) return plan_r.error();
   const MotionPlan& plan = *plan_r;
 
-  for (const std::string& d : {dir, dir + "/gt", dir + "/" + scene.rig.cameras[0].name,
-                               dir + "/" + scene.rig.cameras[1].name}) {
-    if (auto r = make_dir(d); !r) return r.error();
-  }
-  std::vector<FrameEntry> frames;
-  for (int f = 0; f < options.frames; ++f)
-    frames.push_back(FrameEntry{f, frame_timestamp_ns(f, options.fps)});
-  for (auto r :
-       {save_rig(dir + "/rig.yaml", scene.rig), save_frames_csv(dir + "/frames.csv", frames),
-        save_targets(dir + "/targets.yaml", scene.targets),
-        save_model(dir + "/joints.yaml", joint_topology(scene)),
-        save_model(dir + "/gt/model_true.yaml", scene.joints_true)}) {
+  auto frames_r = begin_recording(dir, scene.rig, options.frames, options.fps);
+  if (!frames_r) return frames_r.error();
+  const std::vector<FrameEntry>& frames = *frames_r;
+  for (auto r : {save_targets(dir + "/targets.yaml", scene.targets),
+                 save_model(dir + "/joints.yaml", joint_topology(scene)),
+                 save_model(dir + "/gt/model_true.yaml", scene.joints_true)}) {
     if (!r) return r.error();
   }
 
@@ -160,12 +125,11 @@ Expected<SimSummary> write_simulated_recording(const SimOptions& options, const 
                  s.robot_translation_mm.y(), s.robot_translation_mm.z());
   }
 
-  auto ws0 = RenderWorkspace::create(scene);
-  if (!ws0) return ws0.error();
-  RenderWorkspace ws1 = *ws0;  // copies the read-only lattices instead of recomputing them
-  std::array<RenderWorkspace*, 2> ws = {&*ws0, &ws1};
+  auto stereo = StereoRender::create(scene, options.threads);
+  if (!stereo) return stereo.error();
   std::array<Image, 2> images = {make_camera_image(scene, 0), make_camera_image(scene, 1)};
-  std::array<CameraResult, 2> results;
+  const std::array<const RenderWorkspace*, 2> results = {&stereo->workspace(0),
+                                                         &stereo->workspace(1)};
   SceneState state = make_state(scene);
   SimSummary summary;
   summary.frames = options.frames;
@@ -174,23 +138,11 @@ Expected<SimSummary> write_simulated_recording(const SimOptions& options, const 
   for (int f = 0; f < options.frames; ++f) {
     apply_config(scene, plan.configs[static_cast<std::size_t>(f)], state);
     state.noise_key = frame_noise_key(options.seed, f);
-    auto job = [&](int c) {
-      render_camera(scene, state, c, *ws[static_cast<std::size_t>(c)],
-                    images[static_cast<std::size_t>(c)],
-                    frame_file_path(dir, scene.rig.cameras[static_cast<std::size_t>(c)].name, f),
-                    results[static_cast<std::size_t>(c)]);
-    };
-    if (options.threads >= 2) {
-      std::thread t1(job, 1);
-      job(0);
-      t1.join();
-    } else {
-      job(0);
-      job(1);
-    }
-    for (const CameraResult& r : results) {
-      if (!r.ok) return r.error;
-    }
+    auto rendered = stereo->render(state, {&images[0], &images[1]}, [&](int c) {
+      const auto uc = static_cast<std::size_t>(c);
+      return write_pgm(frame_file_path(dir, scene.rig.cameras[uc].name, f), images[uc].view());
+    });
+    if (!rendered) return rendered.error();
     const std::int64_t ts = frames[static_cast<std::size_t>(f)].timestamp_ns;
     for (int b = 0; b < kBodyCount; ++b) {
       const Iso3& T = state.T_world_body[static_cast<std::size_t>(b)];
@@ -225,17 +177,10 @@ Expected<SimSummary> write_simulated_recording(const SimOptions& options, const 
           markers_csv->handle(), "%d,%s,%d,%.6f,%.6f,%.6f", f,
           scene.targets.bodies[static_cast<std::size_t>(scene.marker_body[um])].name.c_str(),
           scene.marker_index[um], X.x(), X.y(), X.z());
-      for (const CameraResult& r : results) {
-        const MarkerView& mv = r.markers[um];
-        std::fprintf(markers_csv->handle(), ",%.6f,%.6f,%d", mv.center_px.x(), mv.center_px.y(),
-                     mv.isolated() ? 1 : 0);
-        ++summary.marker_views;
-        summary.isolated_views += mv.isolated() ? 1 : 0;
-        summary.occluded_views += (mv.in_front && !mv.dropped && mv.occluded_area_px > 0.0) ? 1 : 0;
-        summary.dropped_views += mv.dropped ? 1 : 0;
-      }
-      for (const CameraResult& r : results) {
-        const MarkerView& mv = r.markers[um];
+      for (const RenderWorkspace* r : results)
+        write_marker_view(markers_csv->handle(), r->markers[um], summary);
+      for (const RenderWorkspace* r : results) {
+        const MarkerView& mv = r->markers[um];
         const double total = mv.visible_area_px + mv.occluded_area_px;
         const double frac = (total > 0.0 && mv.inside_image) ? mv.visible_area_px / total : 0.0;
         std::fprintf(markers_csv->handle(), ",%.4f,%d,%d", frac, mv.merged ? 1 : 0,
@@ -244,7 +189,9 @@ Expected<SimSummary> write_simulated_recording(const SimOptions& options, const 
       std::fputc('\n', markers_csv->handle());
     }
     for (int c = 0; c < 2; ++c) {
-      for (const StrayView& s : results[static_cast<std::size_t>(c)].strays) {
+      const RenderWorkspace& r = *results[static_cast<std::size_t>(c)];
+      for (int k = 0; k < r.stray_count; ++k) {
+        const StrayView& s = r.strays[static_cast<std::size_t>(k)];
         std::fprintf(strays_csv->handle(), "%d,%d,%s,%.4f,%.4f,%.4f,%.4f,%.4f,%.2f\n", f, c,
                      stray_name(s.kind), s.X_world.x(), s.X_world.y(), s.X_world.z(), s.px.x(),
                      s.px.y(), s.peak_dn);

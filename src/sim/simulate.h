@@ -47,6 +47,9 @@ struct SimSummary {
 // The scene these options describe (imaging levels scaled to the bit depth).
 Expected<SimScene> make_scene(const SimOptions& options);
 
+// The motion these options describe (kind, frames, fps, poses, seed).
+MotionSpec motion_spec(const SimOptions& options);
+
 // The per-frame noise key of the renderer (seed and frame only).
 std::uint64_t frame_noise_key(std::uint64_t seed, std::int64_t frame) noexcept;
 

@@ -2,21 +2,21 @@
 // wand_sim.h). The scene reuses the shoulder scenario's rig and imaging (make_scene)
 // so the calibration recordings are seen by exactly the rig the other recordings use.
 // Bodies: 0 = the calibration object, 1 = the room (static glints only).
+// The folder set-up and the two-camera render + PGM writing are frame_writer.h's.
 #include "sim/wand_sim.h"
 
 #include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <numbers>
-#include <thread>
 
 #include "core/rotation.h"
 #include "formats/csv_outputs.h"
 #include "formats/pgm.h"
 #include "formats/recording.h"
 #include "formats/rig_yaml.h"
+#include "sim/frame_writer.h"
 #include "sim/render.h"
 #include "sim/sim_rng.h"
 
@@ -98,14 +98,6 @@ Expected<SimScene> make_calib_scene(const SimOptions& options, CalibObjectKind k
   return scene;
 }
 
-Expected<void> make_dir(const std::string& path) {
-  std::error_code ec;
-  std::filesystem::create_directories(path, ec);
-  if (ec || !std::filesystem::is_directory(path, ec))
-    return make_error(path, "", "cannot create directory");
-  return {};
-}
-
 }  // namespace
 
 CalibrationObjects default_calibration_objects() {
@@ -173,15 +165,9 @@ Expected<SimSummary> write_calibration_recording(const SimOptions& options, Cali
   if (!scene_r) return scene_r.error();
   const SimScene& scene = *scene_r;
   const Rig& rig = scene.rig;
-  for (const std::string& d :
-       {dir, dir + "/gt", dir + "/" + rig.cameras[0].name, dir + "/" + rig.cameras[1].name}) {
-    if (auto r = make_dir(d); !r) return r.error();
-  }
-  std::vector<FrameEntry> frames;
-  for (int f = 0; f < options.frames; ++f)
-    frames.push_back(FrameEntry{f, frame_timestamp_ns(f, options.fps)});
-  for (auto r : {save_rig(dir + "/rig.yaml", rig), save_rig(dir + "/gt/rig_true.yaml", rig),
-                 save_frames_csv(dir + "/frames.csv", frames),
+  if (auto frames = begin_recording(dir, rig, options.frames, options.fps); !frames)
+    return frames.error();
+  for (auto r : {save_rig(dir + "/gt/rig_true.yaml", rig),
                  save_calibration_objects(dir + "/wand.yaml", obj)}) {
     if (!r) return r.error();
   }
@@ -195,13 +181,10 @@ Expected<SimSummary> write_calibration_recording(const SimOptions& options, Cali
       CsvFile::open(dir + "/gt/markers.csv", "frame,marker,x,y,z,u0,v0,vis0,u1,v1,vis1");
   if (!markers_csv) return markers_csv.error();
 
-  auto ws0 = RenderWorkspace::create(scene);
-  if (!ws0) return ws0.error();
-  RenderWorkspace ws1 = *ws0;
-  std::array<RenderWorkspace*, 2> ws = {&*ws0, &ws1};
+  auto stereo = StereoRender::create(scene, options.threads);
+  if (!stereo) return stereo.error();
+  const std::array<const RenderWorkspace*, 2> ws = {&stereo->workspace(0), &stereo->workspace(1)};
   std::array<Image, 2> images = {make_camera_image(scene, 0), make_camera_image(scene, 1)};
-  std::array<bool, 2> ok{};
-  std::array<Error, 2> errors{};
   SceneState state = make_state(scene);
   SimSummary summary;
   summary.frames = options.frames;
@@ -210,43 +193,17 @@ Expected<SimSummary> write_calibration_recording(const SimOptions& options, Cali
     if (kind == CalibObjectKind::kWand)
       state.T_world_body[0] = wand_pose(f, options.frames, options.seed);
     state.noise_key = frame_noise_key(options.seed, f);
-    auto job = [&](int c) {
+    auto rendered = stereo->render(state, {&images[0], &images[1]}, [&](int c) {
       const auto uc = static_cast<std::size_t>(c);
-      ok[uc] = render(scene, state, c, *ws[uc], images[uc]);
-      if (!ok[uc]) {
-        errors[uc] = make_error("simulate", "render", "camera " + std::to_string(c) + " failed");
-        return;
-      }
-      auto w = write_pgm(frame_file_path(dir, rig.cameras[uc].name, f), images[uc].view());
-      if (!w) {
-        ok[uc] = false;
-        errors[uc] = w.error();
-      }
-    };
-    if (options.threads >= 2) {
-      std::thread t1(job, 1);
-      job(0);
-      t1.join();
-    } else {
-      job(0);
-      job(1);
-    }
-    for (std::size_t c = 0; c < 2; ++c) {
-      if (!ok[c]) return errors[c];
-    }
+      return write_pgm(frame_file_path(dir, rig.cameras[uc].name, f), images[uc].view());
+    });
+    if (!rendered) return rendered.error();
     for (int m = 0; m < scene.marker_count(); ++m) {
       const auto um = static_cast<std::size_t>(m);
       const Vec3 X = state.T_world_body[0] * scene.marker_in_body(m);
       std::fprintf(markers_csv->handle(), "%d,%d,%.6f,%.6f,%.6f", f, m, X.x(), X.y(), X.z());
-      for (const RenderWorkspace* w : ws) {
-        const MarkerView& mv = w->markers[um];
-        std::fprintf(markers_csv->handle(), ",%.6f,%.6f,%d", mv.center_px.x(), mv.center_px.y(),
-                     mv.isolated() ? 1 : 0);
-        ++summary.marker_views;
-        summary.isolated_views += mv.isolated() ? 1 : 0;
-        summary.occluded_views += (mv.in_front && !mv.dropped && mv.occluded_area_px > 0.0) ? 1 : 0;
-        summary.dropped_views += mv.dropped ? 1 : 0;
-      }
+      for (const RenderWorkspace* w : ws)
+        write_marker_view(markers_csv->handle(), w->markers[um], summary);
       std::fputc('\n', markers_csv->handle());
     }
     for (const RenderWorkspace* w : ws) {

@@ -9,6 +9,7 @@
 #include <chrono>
 #include <memory>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "hal/sim_camera.h"
@@ -33,12 +34,25 @@ inline std::shared_ptr<const hal::SimFrameLoop> shared_loop() {
   return loop;
 }
 
+// A loop of `frames` frames rendered for one test (a test that needs fewer frames than
+// shared_loop() renders only these, in its own process).
+inline std::shared_ptr<const hal::SimFrameLoop> render_loop(int frames) {
+  sim::SimOptions o;
+  o.frames = frames;
+  auto l = hal::SimFrameLoop::render(o);
+  EXPECT_TRUE(l.ok()) << (l.ok() ? "" : l.error().message);
+  return l.ok() ? *l : nullptr;
+}
+
 struct SimRigFixture {
+  std::shared_ptr<const hal::SimFrameLoop> loop;
   std::shared_ptr<hal::SimTrigger> trigger;
   std::unique_ptr<hal::SimCamera> cams[2];
 
-  explicit SimRigFixture(int buffers = 6) {
-    trigger = std::make_shared<hal::SimTrigger>(shared_loop());
+  // `frames`: the loop to serve (default: shared_loop()).
+  explicit SimRigFixture(int buffers = 6, std::shared_ptr<const hal::SimFrameLoop> frames = {})
+      : loop(frames ? std::move(frames) : shared_loop()) {
+    trigger = std::make_shared<hal::SimTrigger>(loop);
     for (int c = 0; c < 2; ++c) {
       auto cam = hal::SimCamera::open(trigger, c);
       EXPECT_TRUE(cam.ok());
@@ -50,7 +64,7 @@ struct SimRigFixture {
   }
   std::array<hal::Camera*, 2> cameras() { return {cams[0].get(), cams[1].get()}; }
   FrameProcessor processor() const {
-    const sim::SimScene& sc = shared_loop()->scene();
+    const sim::SimScene& sc = loop->scene();
     // The pipeline tests check the plumbing (every frame, in order, true angles), so they
     // also take poses that rest on partly occluded markers (coverage over accuracy).
     TrackerConfig config;

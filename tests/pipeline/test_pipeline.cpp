@@ -72,8 +72,9 @@ TEST(Pipeline, PublishesFramesInOrderWithTrueAngles) {
     all_valid += valid ? 1 : 0;
   }
   // Some loop frames of the scenario are not fully identified (the same ones every
-  // cycle: 79 of 120 complete here, deterministic in lockstep). Most must be complete.
-  EXPECT_GT(all_valid * 2, sink.count()) << "angles valid in more than half of the frames";
+  // cycle, deterministic in lockstep: 56 of 120 complete here; a pose resting on partial
+  // markers needs 4 markers, docs/identification.md). A large share must be complete.
+  EXPECT_GT(all_valid * 3, sink.count()) << "angles valid in more than a third of the frames";
   ASSERT_FALSE(errors_deg.empty());
   std::sort(errors_deg.begin(), errors_deg.end());
   EXPECT_LT(errors_deg[errors_deg.size() / 2], 1.0) << "median angle error (deg)";
@@ -224,6 +225,8 @@ TEST(Pipeline, SetupErrorsAreOneLine) {
   EXPECT_NE(q.error().message.find("ring_depth"), std::string::npos);
   bad = test::test_options();
   bad.trigger_rate_hz = 0.0;
+  EXPECT_FALSE(Pipeline::create(rig2.processor(), rig2.cameras(), {&sink}, bad).ok());
+  bad.trigger_rate_hz = 1e-12;  // its period would overflow the nanosecond clock
   EXPECT_FALSE(Pipeline::create(rig2.processor(), rig2.cameras(), {&sink}, bad).ok());
 }
 

@@ -6,7 +6,12 @@
 //     (camera_max_silence_us_cam1, dequeue_timeouts_cam1) and in health() while it
 //     lasts, and the tracker publishes again afterwards;
 //   * free-running cameras with independent sequence counters pair by timestamp
-//     (PairBy::kTimestamp) and not by sequence.
+//     (PairBy::kTimestamp) and not by sequence;
+//   * camera 0's clock steps 5 s ahead and back, then back and ahead (hal::FaultCamera),
+//     and two of its images are full of blobs: every frame is still processed, the steps
+//     are counted per camera (timestamp_backwards/jumps), the identifier drops its prior
+//     on the steps back (identify_bad_timestamps), and the detector, stereo and
+//     identification counters reach the stats and health() unchanged.
 // The camera wrapper below is local to these tests (a stalled or offset sim camera).
 #include <gtest/gtest.h>
 #include <sys/socket.h>
@@ -15,9 +20,11 @@
 #include <atomic>
 #include <thread>
 
+#include "hal/fault_camera.h"
 #include "pipeline/publish/udp_publisher.h"
 #include "pipeline/stats_report.h"
 #include "tests/pipeline/pipeline_fixture.h"
+#include "tests/support/udp_port.h"
 
 namespace mocap::pipeline {
 namespace {
@@ -80,21 +87,9 @@ class UdpSink final : public JointsSink {
   publish::UdpPublisher p_;
 };
 
-// A UDP port on 127.0.0.1 that nobody listens on (bound, then closed).
-int unused_udp_port() {
-  const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a);
-  socklen_t len = sizeof a;
-  ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len);
-  ::close(fd);
-  return ntohs(a.sin_port);
-}
-
 TEST(PipelineFaults, NoUdpReceiverIsCountedNotFatal) {
-  auto udp = publish::UdpPublisher::create({"127.0.0.1:" + std::to_string(unused_udp_port())});
+  auto udp =
+      publish::UdpPublisher::create({"127.0.0.1:" + std::to_string(mocap::test::free_udp_port())});
   ASSERT_TRUE(udp.ok()) << udp.error().message;
   UdpSink udp_sink(std::move(udp).value());
   RecordingSink record(200);
@@ -213,6 +208,92 @@ TEST(PipelineFaults, FreeRunningCamerasPairByTimestamp) {
         << format_pipeline_stats(st);
     EXPECT_GE(all_found, 5u) << format_pipeline_stats(st);
   }
+}
+
+// Every mirrored counter equals the library's own after stop() (the mirror is the last
+// frame's state, published by the stage thread that owns the library).
+template <class Source, std::size_t N>
+void expect_mirrored(const PipelineStats& st, const std::string& prefix,
+                     const std::array<CounterField<Source>, N>& fields, const Source& source) {
+  for (const CounterField<Source>& f : fields)
+    EXPECT_EQ(counter(st, prefix + f.name), f.read(source)) << prefix << f.name;
+}
+
+TEST(PipelineFaults, ClockStepsAndLibraryCountersAreReported) {
+  SimRigFixture rig(6, test::render_loop(6));  // 6 frames (0..5..0) render in half the time
+  const hal::CameraConfig cfg = rig.cams[0]->config();
+  Image storm(cfg.width, cfg.height, cfg.format, 255);  // 2x2 dots every 5 px: overflows
+  for (int y = 0; y < cfg.height; ++y) {
+    for (int x = 0; x < cfg.width; ++x) storm.row8(y)[x] = (x % 5 < 2 && y % 5 < 2) ? 240 : 10;
+  }
+  const std::int64_t step_ns = 5'000'000'000;
+  auto cam0 = hal::FaultCamera::wrap(*rig.cams[0],
+                                     {{hal::Fault::kTimestampJump, 10, 5, step_ns},
+                                      {hal::Fault::kTimestampJump, 20, 5, -step_ns},
+                                      {hal::Fault::kReplaceImage, 30, 2, 0}},
+                                     &storm);
+  ASSERT_TRUE(cam0.ok()) << cam0.error().message;
+  constexpr std::uint64_t kFrames = 36;
+  RecordingSink record(kFrames);
+  PipelineOptions opt = test::test_options();
+  opt.max_frames = kFrames;
+  opt.pacing = TriggerPacing::kLockstep;  // lossless: every frame reaches identification
+  auto p = Pipeline::create(rig.processor(), {cam0->get(), rig.cams[1].get()}, {&record}, opt);
+  ASSERT_TRUE(p.ok()) << p.error().message;
+  ASSERT_TRUE((*p)->start().ok());
+  test::wait_finished(**p, 20.0);
+  (*p)->stop();
+  const PipelineStats st = (*p)->stats();
+  const PipelineHealth h = (*p)->health();
+  const std::string report = format_pipeline_stats(st);
+  ASSERT_EQ(st.published, kFrames) << report;
+  ASSERT_EQ(record.count(), kFrames);
+
+  // The stepped frames were processed and carry the camera's timestamps unchanged.
+  for (std::size_t i = 1; i < kFrames; ++i) {
+    const std::int64_t dt = record[i].capture_ns - record[i - 1].capture_ns;
+    const bool step_ahead = i == 10 || i == 25, step_back = i == 15 || i == 20;
+    EXPECT_EQ(dt > step_ns / 2, step_ahead) << "frame " << i;
+    EXPECT_EQ(dt < -step_ns / 2, step_back) << "frame " << i;
+  }
+  // Ahead at 10 and 25 (back to the true time), back at 15 and 20; camera 1 is clean.
+  EXPECT_EQ(counter(st, "timestamp_jumps_cam0"), 2u) << report;
+  EXPECT_EQ(counter(st, "timestamp_backwards_cam0"), 2u) << report;
+  EXPECT_EQ(counter(st, "timestamp_jumps_cam1"), 0u) << report;
+  EXPECT_EQ(counter(st, "timestamp_backwards_cam1"), 0u) << report;
+  EXPECT_EQ(h.timestamp_steps[0], 4u);
+  EXPECT_EQ(h.timestamp_steps[1], 0u);
+  const std::string line = format_progress_line(1.0, 1.0, LatencyStats{}, h);
+  EXPECT_NE(line.find(" clock steps=4/0"), std::string::npos) << line;
+  // The identifier saw the two steps back (camera 0's time is the frame's time) and
+  // dropped its prior there instead of predicting across them; tracking resumed.
+  const IdentifyCounters& ic = (*p)->processor().identify_counters();
+  EXPECT_GE(ic.bad_timestamps, 1u) << report;
+  EXPECT_LE(ic.bad_timestamps, 2u) << report;
+  bool resumed = false;
+  for (std::size_t i = 26; i < kFrames; ++i) {
+    for (std::uint16_t j = 0; j < record[i].joint_count; ++j)
+      resumed = resumed || record[i].joints[j].valid != 0;
+  }
+  EXPECT_TRUE(resumed) << "a valid joint angle after the last step";
+
+  // The library counters: the storm overflowed camera 0's detector only.
+  EXPECT_GE(counter(st, "detect_cam0_frames_overflow"), 1u) << report;
+  EXPECT_EQ(counter(st, "detect_cam1_frames_overflow"), 0u) << report;
+  EXPECT_EQ(h.detect_overflow_frames[0], counter(st, "detect_cam0_frames_overflow"));
+  EXPECT_EQ(counter(st, "detect_cam0_frames"), kFrames);
+  EXPECT_GT(counter(st, "detect_cam1_blobs"), kFrames);  // several markers per frame
+  EXPECT_EQ(counter(st, "stereo_frames"), kFrames);
+  EXPECT_EQ(counter(st, "identify_frames"), kFrames);
+  const FrameProcessor& fp = (*p)->processor();
+  expect_mirrored(st, "detect_cam0_", kDetectorFields, fp.detector_counters(0));
+  expect_mirrored(st, "detect_cam1_", kDetectorFields, fp.detector_counters(1));
+  expect_mirrored(st, "stereo_", kStereoFields, fp.stereo_counters());
+  expect_mirrored(st, "identify_", kIdentifyFields, fp.identify_counters());
+  // ... and the JSON of --stats.
+  const std::string json = pipeline_stats_json(st);
+  EXPECT_NE(json.find("\"timestamp_jumps_cam0\": 2"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"identify_bad_timestamps\": "), std::string::npos);
 }
 
 }  // namespace

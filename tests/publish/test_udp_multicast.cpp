@@ -3,31 +3,18 @@
 // get every datagram (SO_REUSEADDR lets them share the port). Skipped, with the reason,
 // only when the kernel refuses multicast on lo. Also: setup errors are one line.
 #include <gtest/gtest.h>
-#include <sys/socket.h>
-#include <unistd.h>
 
 #include <chrono>
 #include <string>
 
 #include "client/udp_receiver.h"
 #include "pipeline/publish/udp_publisher.h"
+#include "tests/support/udp_port.h"
 
 namespace mocap::publish {
 namespace {
 
 constexpr const char* kGroup = "239.255.77.55";
-
-int free_udp_port() {
-  const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a);
-  socklen_t len = sizeof a;
-  ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len);
-  ::close(fd);
-  return ntohs(a.sin_port);
-}
 
 client::JointsMessage message(std::uint64_t seq) {
   client::JointsMessage m;
@@ -42,7 +29,7 @@ client::JointsMessage message(std::uint64_t seq) {
 }
 
 TEST(UdpMulticast, TwoReceiversInTheGroupGetEveryDatagramOnLoopback) {
-  const std::string dest = std::string(kGroup) + ":" + std::to_string(free_udp_port());
+  const std::string dest = std::string(kGroup) + ":" + std::to_string(test::free_udp_port());
   auto rx1 = client::UdpReceiver::create(dest, "127.0.0.1");
   if (!rx1.ok() && rx1.error().message.find("join multicast") != std::string::npos) {
     GTEST_SKIP() << "the kernel refuses multicast on lo here: " << rx1.error().message;

@@ -72,29 +72,12 @@ class DamagedRecording {
 
   // Runs `mocap <args>` under `timeout` (a hang is exit 124 or 137).
   static RunResult run_bounded(const std::string& args, int seconds = 30) {
-    return run_mocap_prefixed("timeout -s KILL " + std::to_string(seconds) + " ", args);
+    return run_mocap(args, seconds);
   }
 
  private:
-  static RunResult run_mocap_prefixed(const std::string& prefix, const std::string& args) {
-    RunResult r;
-    const std::string cmd = prefix + mocap_binary() + " " + args + " 2>&1";
-    FILE* p = popen(cmd.c_str(), "r");
-    if (!p) return r;
-    char buf[4096];
-    size_t n;
-    while ((n = fread(buf, 1, sizeof buf, p)) > 0) r.output.append(buf, n);
-    const int status = pclose(p);
-    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    return r;
-  }
-
   TempDir tmp_;
 };
-
-inline int line_count(const std::string& s) {
-  return static_cast<int>(std::count(s.begin(), s.end(), '\n'));
-}
 
 inline std::string file_name(const std::string& path) {
   return std::filesystem::path(path).filename().string();

@@ -11,46 +11,13 @@
 #include "formats/wand_yaml.h"
 #include "sim/simulate.h"
 #include "sim/wand_sim.h"
+#include "tests/rigcal/opencv_stereo_yaml.h"
 #include "tests/support/test_support.h"
 
 namespace mocap {
 namespace {
 
-const char* kStereo = R"(%YAML:1.0
----
-image_width: 1032
-image_height: 776
-M1: !!opencv-matrix
-   rows: 3
-   cols: 3
-   dt: d
-   data: [ 1291.2, 0., 517.3, 0., 1290.6, 385.9, 0., 0., 1. ]
-D1: !!opencv-matrix
-   rows: 1
-   cols: 5
-   dt: d
-   data: [ -0.121, 0.083, 0.0004, -0.0003, 0. ]
-M2: !!opencv-matrix
-   rows: 3
-   cols: 3
-   dt: d
-   data: [ 1288.7, 0., 513.8, 0., 1288.1, 389.4, 0., 0., 1. ]
-D2: !!opencv-matrix
-   rows: 1
-   cols: 5
-   dt: d
-   data: [ -0.118, 0.079, -0.0002, 0.0005, 0. ]
-R: !!opencv-matrix
-   rows: 3
-   cols: 3
-   dt: d
-   data: [ 0.9305, 0., -0.3663, 0., 1., 0., 0.3663, 0., 0.9305 ]
-T: !!opencv-matrix
-   rows: 3
-   cols: 1
-   dt: d
-   data: [ -443.8, 0., 174.7 ]
-)";
+const std::string kStereo = test::opencv_stereo_yaml(/*with_image_size=*/true, 5);
 
 // A small wand recording drawn directly (discs at the wand's projections on a flat
 // background): rendering with the simulator is too slow for a test under ASan.

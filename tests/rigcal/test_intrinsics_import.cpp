@@ -7,6 +7,7 @@
 
 #include "formats/intrinsics_import.h"
 #include "formats/wand_yaml.h"
+#include "tests/rigcal/opencv_stereo_yaml.h"
 #include "tests/support/test_support.h"
 
 namespace mocap {
@@ -36,39 +37,7 @@ distortion_coefficients: !!opencv-matrix
 avg_reprojection_error: 2.1e-01
 )";
 
-const char* kOpenCvStereo = R"(%YAML:1.0
----
-M1: !!opencv-matrix
-   rows: 3
-   cols: 3
-   dt: d
-   data: [ 1291.2, 0., 517.3, 0., 1290.6, 385.9, 0., 0., 1. ]
-D1: !!opencv-matrix
-   rows: 1
-   cols: 8
-   dt: d
-   data: [ -0.121, 0.083, 0.0004, -0.0003, 0., 0., 0., 0. ]
-M2: !!opencv-matrix
-   rows: 3
-   cols: 3
-   dt: d
-   data: [ 1288.7, 0., 513.8, 0., 1288.1, 389.4, 0., 0., 1. ]
-D2: !!opencv-matrix
-   rows: 1
-   cols: 5
-   dt: d
-   data: [ -0.118, 0.079, -0.0002, 0.0005, 0. ]
-R: !!opencv-matrix
-   rows: 3
-   cols: 3
-   dt: d
-   data: [ 0.9305, 0., -0.3663, 0., 1., 0., 0.3663, 0., 0.9305 ]
-T: !!opencv-matrix
-   rows: 3
-   cols: 1
-   dt: d
-   data: [ -443.8, 0., 174.7 ]
-)";
+const std::string kOpenCvStereo = test::opencv_stereo_yaml(/*with_image_size=*/false, 8);
 
 const char* kRosLeft = R"(image_width: 1032
 image_height: 776

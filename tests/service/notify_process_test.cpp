@@ -149,19 +149,41 @@ std::string dump(const FakeServiceManager& sm, std::int64_t t0) {
   return s;
 }
 
-TEST(ServiceProcess, ReadyThenWatchdogAtHalfTheTimeout) {
-  TempDir dir("svc_notify");
-  FakeServiceManager sm(dir.file("notify.sock"));
-  ASSERT_TRUE(sm.ok());
-  const std::string cfg = write_config(dir, "");
-  const std::int64_t t0 = now_ns();
-  Child c = spawn_mocap({"run", "--config", cfg, "--duration", "0.8"},
+// `mocap run` on the tiny replay (config_extra appended to its configuration) for
+// duration_s under the fake service manager with WATCHDOG_USEC=100000 (pings due
+// every 50 ms), collected to its end (killed after 20 s).
+struct WatchdogRun {
+  explicit WatchdogRun(const std::string& tag) : dir(tag), sm(dir.file("notify.sock")) {}
+
+  // False when the socket could not be bound or mocap not be started.
+  bool run_to_end(const std::string& config_extra, const std::string& duration_s) {
+    if (!sm.ok()) return false;
+    const std::string cfg = write_config(dir, config_extra);
+    t0 = now_ns();
+    child = spawn_mocap({"run", "--config", cfg, "--duration", duration_s},
                         {"NOTIFY_SOCKET=" + dir.file("notify.sock"), "WATCHDOG_USEC=100000"},
                         dir.file("log.txt"));
-  ASSERT_GT(c.pid, 0);
-  collect_until_exit(sm, c, 20000);
-  ASSERT_TRUE(WIFEXITED(c.status) && WEXITSTATUS(c.status) == 0) << read_file(dir.file("log.txt"));
-  const std::string trace = dump(sm, t0);
+    if (child.pid <= 0) return false;
+    collect_until_exit(sm, child, 20000);
+    return true;
+  }
+  bool exited_ok() const { return WIFEXITED(child.status) && WEXITSTATUS(child.status) == 0; }
+  std::string log() const { return read_file(dir.file("log.txt")); }
+  // Every notification with its time since the start, for failure messages.
+  std::string trace() const { return dump(sm, t0); }
+
+  TempDir dir;
+  FakeServiceManager sm;
+  std::int64_t t0 = 0;
+  Child child;
+};
+
+TEST(ServiceProcess, ReadyThenWatchdogAtHalfTheTimeout) {
+  WatchdogRun run("svc_notify");
+  ASSERT_TRUE(run.run_to_end("", "0.8")) << "cannot bind the notify socket or start mocap";
+  ASSERT_TRUE(run.exited_ok()) << run.log();
+  const FakeServiceManager& sm = run.sm;
+  const std::string trace = run.trace();
   ASSERT_EQ(sm.count("READY=1"), 1) << trace;
   ASSERT_EQ(sm.count("STOPPING=1"), 1) << trace;
   std::size_t ready = 0, stopping = 0;
@@ -189,19 +211,14 @@ TEST(ServiceProcess, ReadyThenWatchdogAtHalfTheTimeout) {
 }
 
 TEST(ServiceProcess, NoWatchdogOnceThePipelineStalls) {
-  TempDir dir("svc_stall");
-  FakeServiceManager sm(dir.file("notify.sock"));
-  ASSERT_TRUE(sm.ok());
-  const std::string cfg = write_config(dir, "fault_injection: {stall_after_frames: 20}\n");
-  const std::int64_t t0 = now_ns();
-  Child c = spawn_mocap({"run", "--config", cfg, "--duration", "1.0"},
-                        {"NOTIFY_SOCKET=" + dir.file("notify.sock"), "WATCHDOG_USEC=100000"},
-                        dir.file("log.txt"));
-  ASSERT_GT(c.pid, 0);
-  collect_until_exit(sm, c, 20000);
-  const std::string log = read_file(dir.file("log.txt"));
-  ASSERT_TRUE(WIFEXITED(c.status) && WEXITSTATUS(c.status) == 0) << log;
-  const std::string trace = dump(sm, t0);
+  WatchdogRun run("svc_stall");
+  ASSERT_TRUE(run.run_to_end("fault_injection: {stall_after_frames: 20}\n", "1.0"))
+      << "cannot bind the notify socket or start mocap";
+  const std::string log = run.log();
+  ASSERT_TRUE(run.exited_ok()) << log;
+  const FakeServiceManager& sm = run.sm;
+  const std::int64_t t0 = run.t0;
+  const std::string trace = run.trace();
   ASSERT_EQ(sm.count("READY=1"), 1) << trace;
   std::int64_t last_ping = 0, stopping = 0;
   for (const Note& n : sm.notes) {

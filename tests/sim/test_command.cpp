@@ -13,18 +13,12 @@ namespace {
 
 namespace fs = std::filesystem;
 
-int count_lines(const std::string& text) {
-  int n = 0;
-  for (char c : text) n += c == '\n';
-  return n;
-}
-
 TEST(SimCommand, WritesAHundredFrameRecording) {
   test::TempDir dir("sim_cmd");
   const std::string out = dir.file("rec");
   const auto r = test::run_mocap("simulate --out " + out + " --frames 100");
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_EQ(count_lines(r.output), 1) << r.output;
+  EXPECT_EQ(test::line_count(r.output), 1) << r.output;
   EXPECT_NE(r.output.find("100 frames"), std::string::npos);
   for (const char* f : {"rig.yaml", "frames.csv", "targets.yaml", "joints.yaml", "gt/poses.csv",
                         "gt/angles.csv", "gt/markers.csv", "gt/model_true.yaml", "cam0/000000.pgm",
@@ -42,13 +36,13 @@ TEST(SimCommand, BadOptionsGiveOneLineErrors) {
         "--motion poses --frames 5", "--bits 16 --maxval 70000", "--fps 0", "--noise -1"}) {
     const auto r = test::run_mocap("simulate --out " + out + " " + std::string(args));
     EXPECT_NE(r.exit_code, 0) << args;
-    EXPECT_EQ(count_lines(r.output), 1) << args << ": " << r.output;
+    EXPECT_EQ(test::line_count(r.output), 1) << args << ": " << r.output;
     EXPECT_EQ(r.output.rfind("mocap: simulate: ", 0), 0u) << args << ": " << r.output;
   }
   test::write_file(dir.file("file"), "x");
   const auto r = test::run_mocap("simulate --frames 2 --out " + dir.file("file") + "/sub");
   EXPECT_NE(r.exit_code, 0);
-  EXPECT_EQ(count_lines(r.output), 1) << r.output;
+  EXPECT_EQ(test::line_count(r.output), 1) << r.output;
   EXPECT_NE(r.output.find("cannot create"), std::string::npos) << r.output;
 }
 

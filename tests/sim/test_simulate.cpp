@@ -20,12 +20,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-int count_lines(const std::string& text) {
-  int n = 0;
-  for (char c : text) n += c == '\n';
-  return n;
-}
-
 TEST(SimRecording, LoadsBackAndGroundTruthIsConsistent) {
   test::TempDir dir("sim_rec");
   SimOptions opt;
@@ -84,9 +78,9 @@ TEST(SimRecording, LoadsBackAndGroundTruthIsConsistent) {
   // Ground-truth marker table: one row per marker and frame.
   const std::string markers = test::read_file(dir.file("gt/markers.csv"));
   EXPECT_EQ(markers.rfind("frame,body,marker,x,y,z,u0,v0,vis0,u1,v1,vis1", 0), 0u);
-  EXPECT_EQ(count_lines(markers), 1 + 12 * 14);
+  EXPECT_EQ(test::line_count(markers), 1 + 12 * 14);
   EXPECT_TRUE(fs::exists(dir.file("gt/strays.csv")));
-  EXPECT_EQ(count_lines(test::read_file(dir.file("gt/segments.csv"))), 1 + 4);
+  EXPECT_EQ(test::line_count(test::read_file(dir.file("gt/segments.csv"))), 1 + 4);
 }
 
 TEST(SimRecording, ThreadsDoNotChangeTheOutput) {

@@ -1,13 +1,17 @@
-// Design: small helpers shared by the tests: temporary folders, file writing, the path
-// of the built `mocap` binary, and running it to capture its exit code and stderr.
+// Design: small helpers shared by the tests: temporary folders, file reading and
+// writing, counting lines, the path of the built `mocap` binary, and running it (or
+// any shell command, optionally under a time limit) to capture its exit code and
+// output.
 #pragma once
 
+#include <sys/wait.h>
+
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
-#include <sys/wait.h>
 
 namespace mocap::test {
 
@@ -15,7 +19,8 @@ namespace mocap::test {
 class TempDir {
  public:
   explicit TempDir(const std::string& tag) {
-    std::string templ = (std::filesystem::temp_directory_path() / ("mocap_" + tag + "_XXXXXX")).string();
+    std::string templ =
+        (std::filesystem::temp_directory_path() / ("mocap_" + tag + "_XXXXXX")).string();
     char* p = mkdtemp(templ.data());
     path_ = p ? std::string(p) : std::string();
   }
@@ -43,6 +48,11 @@ inline std::string read_file(const std::string& path) {
   return std::string(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
 }
 
+// The number of '\n' in text (the lines of a program's output or of a CSV file).
+inline int line_count(const std::string& text) {
+  return static_cast<int>(std::count(text.begin(), text.end(), '\n'));
+}
+
 #ifndef MOCAP_TEST_SOURCE_DIR
 #define MOCAP_TEST_SOURCE_DIR "."
 #endif
@@ -67,10 +77,10 @@ struct RunResult {
   std::string output;  // stdout and stderr together
 };
 
-// Runs `mocap <args>` through the shell, capturing stdout+stderr.
-inline RunResult run_mocap(const std::string& args) {
+// Runs a shell command line, capturing stdout+stderr (append " 2>&1" to cmd to get
+// stderr too). exit_code -1 when it could not run or did not exit normally (signal).
+inline RunResult run_command(const std::string& cmd) {
   RunResult r;
-  const std::string cmd = mocap_binary() + " " + args + " 2>&1";
   FILE* p = popen(cmd.c_str(), "r");
   if (!p) return r;
   char buf[4096];
@@ -79,6 +89,15 @@ inline RunResult run_mocap(const std::string& args) {
   const int status = pclose(p);
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return r;
+}
+
+// Runs `mocap <args>` through the shell, capturing stdout+stderr. timeout_s > 0 runs it
+// under `timeout -s KILL <timeout_s>`, so that a hang fails the test (exit 137) instead
+// of stalling CI.
+inline RunResult run_mocap(const std::string& args, int timeout_s = 0) {
+  const std::string prefix =
+      timeout_s > 0 ? "timeout -s KILL " + std::to_string(timeout_s) + " " : std::string();
+  return run_command(prefix + mocap_binary() + " " + args + " 2>&1");
 }
 
 }  // namespace mocap::test
