@@ -21,6 +21,9 @@ packages=(
   libboost-dev
   # CRC-32 reference of the client tests, and the plots of the evaluation script
   zlib1g-dev gnuplot-nox
+  # ecosystem outputs: ROS 2 over DDS (Cyclone DDS C API + idlc), the Foxglove WebSocket
+  # server (Boost.Beast from libboost-dev, nlohmann-json)
+  cyclonedds-dev cyclonedds-tools nlohmann-json3-dev
   # the OpenCV comparison baseline of bench/ (never linked by the product)
   libopencv-dev
 )
@@ -30,6 +33,11 @@ if [ "$(id -u)" -ne 0 ]; then
   if command -v sudo >/dev/null 2>&1; then SUDO="sudo"; else
     echo "install-deps.sh: must run as root (or with sudo available)" >&2; exit 1; fi
 fi
+
+# Node.js and npm run only the test-only reference protocol clients (tests/, never the
+# build or the tracker). Machines that already ship a Node.js with npm keep it; otherwise
+# Debian's packages are added.
+if ! command -v npm >/dev/null 2>&1; then packages+=(nodejs npm); fi
 
 missing=()
 for p in "${packages[@]}"; do
