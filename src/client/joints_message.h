@@ -23,6 +23,21 @@ struct JointRecord {
 
 inline constexpr std::uint32_t kFlagAllBodiesFound = 1u << 0;
 
+// How a joint's angles were obtained in this frame (2026-12 extension).
+enum class SolvedBy : std::uint8_t {
+  kNone = 0,   // not valid in this frame
+  kPoses = 1,  // from the full poses of both bodies (R_parent^T R_child)
+  kChain = 2,  // from the kinematic chain: the parent's pose, the calibrated joint and
+               // whatever child markers were seen (1+ for a hinge, 2+ for a ball)
+};
+
+// Per-joint quality of the angles (2026-12 extension, not in the UDP datagram v1).
+struct JointQuality {
+  std::uint8_t solved_by = 0;  // SolvedBy
+  std::uint8_t reserved[3] = {0, 0, 0};
+  float sd_rad[3] = {0.0f, 0.0f, 0.0f};  // standard deviation of a0, a1, a2 (radians)
+};
+
 struct JointsMessage {
   std::uint64_t sequence = 0;     // counts every triggered frame: a gap means drops
   std::int64_t capture_ns = 0;    // CLOCK_MONOTONIC, trigger of this frame
@@ -31,8 +46,12 @@ struct JointsMessage {
   std::uint16_t joint_count = 0;  // records used in `joints`
   std::uint16_t reserved = 0;
   JointRecord joints[kMaxJoints];
+  // Appended by the 2026-12 extension (the layout above is unchanged): quality[j] belongs
+  // to joints[j].
+  JointQuality quality[kMaxJoints];
 };
 
 static_assert(sizeof(JointRecord) == 32, "the UDP joint record is 32 bytes");
+static_assert(sizeof(JointQuality) == 16, "JointQuality is 16 bytes");
 
 }  // namespace mocap::client

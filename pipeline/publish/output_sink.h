@@ -1,0 +1,53 @@
+// Design: the output seam. Every output of the live tracker (UDP, iceoryx, ROS 2 over
+// DDS, the Foxglove live view, ...) is an OutputSink built at setup from the run
+// configuration's `outputs:` list and the CLI flags through one registry, and called by
+// the publish stage once per frame with the frame's whole result (frame_result.h).
+// publish() runs on the real-time publish thread: noexcept, no allocation, no locks, no
+// blocking; a false return is counted by the caller and never stops the pipeline. A
+// slow encoder (JSON, DDS, disk) does not encode in publish(): it copies the result into
+// a bounded drop-oldest queue drained by its own non-real-time thread, and counts drops.
+// Names of bodies, markers and joints reach the sinks once, at setup (OutputContext).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "pipeline/publish/frame_result.h"
+
+namespace mocap::publish {
+
+// What a sink may need to know at setup (copied by the sink; lives only during create).
+struct OutputContext {
+  std::vector<std::string> body_names;                 // targets.yaml order
+  std::vector<std::vector<std::string>> marker_names;  // per body: BODY_mN
+  std::vector<std::string> joint_names;                // model.yaml order
+  std::vector<std::uint8_t> joint_is_hinge;            // model.yaml order
+  double frame_rate_hz = 0.0;                          // trigger rate, 0 if unknown
+};
+
+// Counters every sink reports (read from other threads: relaxed snapshots).
+struct OutputCounters {
+  std::uint64_t published = 0;  // frames handed over to the transport / encoder
+  std::uint64_t failures = 0;   // frames the transport refused
+  std::uint64_t dropped = 0;    // frames dropped by a bounded queue (drop-oldest)
+};
+
+class OutputSink {
+ public:
+  OutputSink() = default;
+  OutputSink(const OutputSink&) = delete;
+  OutputSink& operator=(const OutputSink&) = delete;
+  virtual ~OutputSink() = default;
+
+  // Short name for statistics and messages ("udp", "iceoryx", "ros2", "foxglove").
+  virtual const char* name() const noexcept = 0;
+  // Publish thread only. False: not delivered (counted by the caller).
+  virtual bool publish(const FrameResult& frame) noexcept = 0;
+  // Counter snapshot (any thread).
+  virtual OutputCounters counters() const noexcept = 0;
+  // One line to print once at start (for example a missing daemon), or empty.
+  virtual std::string notice() const { return {}; }
+};
+
+}  // namespace mocap::publish
