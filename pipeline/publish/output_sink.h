@@ -11,19 +11,19 @@
 
 #include <cstdint>
 #include <string>
-#include <vector>
 
+#include "formats/joints_yaml.h"
+#include "formats/targets_yaml.h"
 #include "pipeline/publish/frame_result.h"
 
 namespace mocap::publish {
 
-// What a sink may need to know at setup (copied by the sink; lives only during create).
+// What a sink may need to know at setup. The pointers live only during the sink's
+// create(): a sink copies what it keeps (names, joint centres and axes).
 struct OutputContext {
-  std::vector<std::string> body_names;                 // targets.yaml order
-  std::vector<std::vector<std::string>> marker_names;  // per body: BODY_mN
-  std::vector<std::string> joint_names;                // model.yaml order
-  std::vector<std::uint8_t> joint_is_hinge;            // model.yaml order
-  double frame_rate_hz = 0.0;                          // trigger rate, 0 if unknown
+  const TargetSet* targets = nullptr;  // body and marker order of FrameResult
+  const JointModel* model = nullptr;   // joint order of FrameResult::joints; may be null
+  double frame_rate_hz = 0.0;          // trigger rate, 0 if unknown
 };
 
 // Counters every sink reports (read from other threads: relaxed snapshots).
