@@ -31,8 +31,15 @@ void make_joints_message(std::uint64_t sequence, std::int64_t capture_ns, const 
     r.q[1] = static_cast<float>(a.q_parent_child.x());
     r.q[2] = static_cast<float>(a.q_parent_child.y());
     r.q[3] = static_cast<float>(a.q_parent_child.z());
+    client::JointQuality& qual = msg.quality[j];
+    qual = client::JointQuality{};
+    qual.solved_by = static_cast<std::uint8_t>(a.valid ? a.solved_by : client::SolvedBy::kNone);
+    for (std::size_t k = 0; k < 3; ++k) qual.sd_rad[k] = static_cast<float>(a.sd_rad[k]);
   }
-  for (std::size_t j = n; j < client::kMaxJoints; ++j) msg.joints[j] = client::JointRecord{};
+  for (std::size_t j = n; j < client::kMaxJoints; ++j) {
+    msg.joints[j] = client::JointRecord{};
+    msg.quality[j] = client::JointQuality{};
+  }
 }
 
 }  // namespace mocap::pipeline

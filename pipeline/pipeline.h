@@ -204,6 +204,8 @@ class Pipeline {
     struct alignas(64) IdentifyLibrary {  // identify
       StereoMirror stereo;
       IdentifyMirror identify;
+      ChainMirror chain;        // zero without a model
+      CoverageMirror coverage;  // per joint
     };
     IdentifyLibrary identify_library;
   };

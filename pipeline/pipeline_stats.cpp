@@ -107,6 +107,16 @@ PipelineStats Pipeline::stats() const {
   for (std::size_t i = 0; i < kIdentifyFields.size(); ++i)
     s.counters.emplace_back(std::string("identify_") + kIdentifyFields[i].name,
                             lib.identify.get(i));
+  if (processor_.has_model()) {
+    for (std::size_t i = 0; i < kChainFields.size(); ++i)
+      s.counters.emplace_back(std::string("chain_") + kChainFields[i].name, lib.chain.get(i));
+    const auto& joints = processor_.model().joints;
+    for (std::size_t j = 0; j < joints.size() && 2 * j + 1 < kCoverageFields.size(); ++j) {
+      s.counters.emplace_back("coverage_" + joints[j].name + "_poses", lib.coverage.get(2 * j));
+      s.counters.emplace_back("coverage_" + joints[j].name + "_chain",
+                              lib.coverage.get(2 * j + 1));
+    }
+  }
   return s;
 }
 

@@ -134,6 +134,10 @@ void Pipeline::identify_loop() noexcept {
     processor_.process_blobs(capture_ns, out);
     k.identify_library.stereo.publish(kStereoFields, processor_.stereo_counters());
     k.identify_library.identify.publish(kIdentifyFields, processor_.identify_counters());
+    if (const ChainCounters* chain = processor_.chain_counters()) {
+      k.identify_library.chain.publish(kChainFields, *chain);
+      k.identify_library.coverage.publish(kCoverageFields, *chain);
+    }
     if (options_.observer) options_.observer->observe(sequence, capture_ns, out);
     rt::SlotHandle m;
     if (msg_pool_->acquire(m)) {

@@ -16,10 +16,12 @@
 #include <cstddef>
 #include <cstdint>
 #include <string_view>
+#include <utility>
 
 #include "detect/blob.h"
 #include "identify/identify_types.h"
 #include "stereo/stereo_triangulator.h"
+#include "track/chain_solver.h"
 
 namespace mocap::pipeline {
 
@@ -124,10 +126,42 @@ inline constexpr std::array<CounterField<IdentifyCounters>, 16> kIdentifyFields 
     MOCAP_COUNTER_FIELD(IdentifyCounters, partial_rejects),
 }};
 
+// Reported as chain_<name>.
+inline constexpr std::array<CounterField<ChainCounters>, 9> kChainFields = {{
+    MOCAP_COUNTER_FIELD(ChainCounters, frames),
+    MOCAP_COUNTER_FIELD(ChainCounters, attempts),
+    MOCAP_COUNTER_FIELD(ChainCounters, joints_solved),
+    MOCAP_COUNTER_FIELD(ChainCounters, too_few_labels),
+    MOCAP_COUNTER_FIELD(ChainCounters, ambiguous_labels),
+    MOCAP_COUNTER_FIELD(ChainCounters, chi2_drops),
+    MOCAP_COUNTER_FIELD(ChainCounters, chi2_rejects),
+    MOCAP_COUNTER_FIELD(ChainCounters, uncertain_rejects),
+    MOCAP_COUNTER_FIELD(ChainCounters, node_limit_hits),
+}};
 #undef MOCAP_COUNTER_FIELD
+
+// Coverage per joint (model order): entry 2j counts the frames joint j was valid from
+// the two poses, 2j+1 through the chain; reported as coverage_<joint>_poses / _chain.
+template <std::size_t... I>
+constexpr std::array<CounterField<ChainCounters>, 2 * sizeof...(I)> make_coverage_fields(
+    std::index_sequence<I...>) noexcept {
+  std::array<CounterField<ChainCounters>, 2 * sizeof...(I)> f{};
+  ((f[2 * I] = {"poses", [](const ChainCounters& s) noexcept -> std::uint64_t {
+                  return s.joint_poses[I];
+                }},
+    f[2 * I + 1] = {"chain", [](const ChainCounters& s) noexcept -> std::uint64_t {
+                      return s.joint_chain[I];
+                    }}),
+   ...);
+  return f;
+}
+inline constexpr auto kCoverageFields =
+    make_coverage_fields(std::make_index_sequence<std::tuple_size_v<decltype(ChainCounters::joint_poses)>>{});
 
 using DetectorMirror = CounterMirror<detect::DetectorCounters, kDetectorFields.size()>;
 using StereoMirror = CounterMirror<StereoCounters, kStereoFields.size()>;
 using IdentifyMirror = CounterMirror<IdentifyCounters, kIdentifyFields.size()>;
+using ChainMirror = CounterMirror<ChainCounters, kChainFields.size()>;
+using CoverageMirror = CounterMirror<ChainCounters, kCoverageFields.size()>;
 
 }  // namespace mocap::pipeline

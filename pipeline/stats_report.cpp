@@ -3,8 +3,41 @@
 #include "pipeline/stats_report.h"
 
 #include <cstdio>
+#include <string>
+#include <vector>
 
 namespace mocap::pipeline {
+namespace {
+
+// Per-joint coverage read back from the coverage_<joint>_poses/_chain counters, as
+// shares of the frames chain tracking processed (chain_frames).
+struct JointCoverage {
+  std::string joint;
+  double poses = 0.0, chain = 0.0;
+};
+
+std::vector<JointCoverage> coverage_of(const PipelineStats& s) {
+  std::uint64_t frames = 0;
+  for (const auto& [name, v] : s.counters)
+    if (name == "chain_frames") frames = v;
+  std::vector<JointCoverage> out;
+  if (frames == 0) return out;
+  const std::string prefix = "coverage_", poses = "_poses";
+  for (const auto& [name, v] : s.counters) {
+    if (name.rfind(prefix, 0) != 0 || name.size() <= prefix.size() + poses.size() ||
+        name.compare(name.size() - poses.size(), poses.size(), poses) != 0)
+      continue;
+    JointCoverage c;
+    c.joint = name.substr(prefix.size(), name.size() - prefix.size() - poses.size());
+    c.poses = static_cast<double>(v) / static_cast<double>(frames);
+    for (const auto& [n2, v2] : s.counters)
+      if (n2 == prefix + c.joint + "_chain") c.chain = static_cast<double>(v2) / static_cast<double>(frames);
+    out.push_back(c);
+  }
+  return out;
+}
+
+}  // namespace
 
 std::string format_pipeline_stats(const PipelineStats& s) {
   std::string out;
@@ -20,6 +53,15 @@ std::string format_pipeline_stats(const PipelineStats& s) {
                   static_cast<unsigned long long>(l.count), l.p50_us, l.p99_us, l.p999_us,
                   l.max_us);
     out += line;
+  }
+  const std::vector<JointCoverage> cov = coverage_of(s);
+  if (!cov.empty()) {
+    out += "joint coverage (share of processed frames)   valid    poses    chain\n";
+    for (const JointCoverage& c : cov) {
+      std::snprintf(line, sizeof line, "  %-40s %6.1f%% %7.1f%% %7.1f%%\n", c.joint.c_str(),
+                    100.0 * (c.poses + c.chain), 100.0 * c.poses, 100.0 * c.chain);
+      out += line;
+    }
   }
   out += "counters:";
   int n = 0;
@@ -76,6 +118,15 @@ std::string pipeline_stats_json(const PipelineStats& s) {
     std::snprintf(buf, sizeof buf, "%s\n    \"%s\": %llu", i == 0 ? "" : ",",
                   s.counters[i].first.c_str(),
                   static_cast<unsigned long long>(s.counters[i].second));
+    out += buf;
+  }
+  out += "\n  },\n  \"coverage\": {";
+  const std::vector<JointCoverage> cov = coverage_of(s);
+  for (std::size_t i = 0; i < cov.size(); ++i) {
+    std::snprintf(buf, sizeof buf,
+                  "%s\n    \"%s\": {\"valid\": %.5f, \"poses\": %.5f, \"chain\": %.5f}",
+                  i == 0 ? "" : ",", cov[i].joint.c_str(), cov[i].poses + cov[i].chain,
+                  cov[i].poses, cov[i].chain);
     out += buf;
   }
   out += "\n  }\n}\n";

@@ -31,6 +31,19 @@ enum class SolvedBy : std::uint8_t {
                // whatever child markers were seen (1+ for a hinge, 2+ for a ball)
 };
 
+// "poses", "chain" or "none" (the solved_by column of angles.csv and mocap echo).
+inline constexpr const char* solved_by_name(SolvedBy s) noexcept {
+  switch (s) {
+    case SolvedBy::kPoses:
+      return "poses";
+    case SolvedBy::kChain:
+      return "chain";
+    case SolvedBy::kNone:
+      break;
+  }
+  return "none";
+}
+
 // Per-joint quality of the angles (2026-12 extension, not in the UDP datagram v1).
 struct JointQuality {
   std::uint8_t solved_by = 0;  // SolvedBy

@@ -19,6 +19,9 @@ namespace {
 constexpr const char* kPointsHeader = "frame,x,y,z,reproj_px";
 constexpr const char* kPosesHeader = "frame,timestamp_ns,body,qw,qx,qy,qz,tx,ty,tz,markers,rms_mm";
 constexpr const char* kAnglesHeader = "frame,timestamp_ns,joint,type,a0,a1,a2,qw,qx,qy,qz";
+// The header written: the spec's columns plus the 2026-12 extension columns at the end.
+constexpr const char* kAnglesHeaderWritten =
+    "frame,timestamp_ns,joint,type,a0,a1,a2,qw,qx,qy,qz,solved_by,sd_a0,sd_a1,sd_a2";
 
 Quat qw_positive(const Quat& q) noexcept {
   if (q.w() < 0.0) return Quat(-q.w(), -q.x(), -q.y(), -q.z());
@@ -62,7 +65,7 @@ Expected<CsvFile> open_poses_csv(const std::string& path) {
   return CsvFile::open(path, kPosesHeader);
 }
 Expected<CsvFile> open_angles_csv(const std::string& path) {
-  return CsvFile::open(path, kAnglesHeader);
+  return CsvFile::open(path, kAnglesHeaderWritten);
 }
 
 void write_row(CsvFile& f, const PointRow& r) noexcept {
@@ -83,10 +86,12 @@ void write_row(CsvFile& f, const PoseRow& r) noexcept {
 void write_row(CsvFile& f, const AngleRow& r) noexcept {
   if (!f.handle()) return;
   const Quat q = qw_positive(r.q_parent_child);
-  std::fprintf(f.handle(), "%lld,%lld,%s,%s,%.6f,%.6f,%.6f,%.9f,%.9f,%.9f,%.9f\n",
+  std::fprintf(f.handle(), "%lld,%lld,%s,%s,%.6f,%.6f,%.6f,%.9f,%.9f,%.9f,%.9f,%s,%.6f,%.6f,%.6f\n",
                static_cast<long long>(r.frame), static_cast<long long>(r.timestamp_ns),
                r.joint.c_str(), joint_type_name(r.type), r.angles_deg.x(), r.angles_deg.y(),
-               r.angles_deg.z(), q.w(), q.x(), q.y(), q.z());
+               r.angles_deg.z(), q.w(), q.x(), q.y(), q.z(),
+               r.solved_by.empty() ? "none" : r.solved_by.c_str(), r.sd_deg.x(),
+               r.sd_deg.y(), r.sd_deg.z());
 }
 
 Expected<std::vector<PointRow>> read_points_csv(const std::string& path) {
@@ -151,6 +156,10 @@ Expected<std::vector<AngleRow>> read_angles_csv(const std::string& path) {
       }
       a.angles_deg = Vec3(r.number(4), r.number(5), r.number(6));
       a.q_parent_child = read_quat(r, 7);
+      if (r.has_column(14)) {
+        a.solved_by = std::string(r.text(11));
+        a.sd_deg = Vec3(r.number(12), r.number(13), r.number(14));
+      }
       rows.push_back(std::move(a));
     }
     return rows;

@@ -39,6 +39,11 @@ struct AngleRow {
   JointType type = JointType::kBall;
   Vec3 angles_deg = Vec3::Zero();  // hinge: (angle, 0, 0)
   Quat q_parent_child = Quat::Identity();
+  // Extension columns (2026-12): how the angle was solved ("poses" or "chain") and the
+  // standard deviations of a0..a2 in degrees ("truth" in the simulator's gt/angles.csv;
+  // written as "none" when empty). Files without them read as "" and 0.
+  std::string solved_by;
+  Vec3 sd_deg = Vec3::Zero();
 };
 
 // A CSV file opened for writing; the header is written at open.

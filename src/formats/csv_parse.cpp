@@ -65,9 +65,16 @@ bool CsvReader::next() {
   return false;
 }
 
+std::string CsvReader::column_name(std::size_t column) const {
+  return column < columns_.size() ? columns_[column] : std::to_string(column + 1);
+}
+
 std::string_view CsvReader::text(std::size_t column) const {
   const std::string_view f = fields_[column];
-  if (f.empty()) fail(where(), "column '" + columns_[column] + "': empty field");
+  if (f.empty())
+    fail(where(), "column '" +
+                      column_name(column) +
+                      "': empty field");
   return f;
 }
 
@@ -79,15 +86,15 @@ double CsvReader::number(std::size_t column) const {
       return v;
     case NumberStatus::kNotFinite:
       fail(where(),
-           "column '" + columns_[column] + "': not a finite number: '" + std::string(f) + "'");
+           "column '" + column_name(column) + "': not a finite number: '" + std::string(f) + "'");
     case NumberStatus::kOutOfRange:
       fail(where(),
-           "column '" + columns_[column] + "': number out of range: '" + std::string(f) + "'");
+           "column '" + column_name(column) + "': number out of range: '" + std::string(f) + "'");
     case NumberStatus::kNotANumber:
       break;
   }
   fail(where(),
-       "column '" + columns_[column] + "': expected a number, got '" + std::string(f) + "'");
+       "column '" + column_name(column) + "': expected a number, got '" + std::string(f) + "'");
 }
 
 std::int64_t CsvReader::integer(std::size_t column) const {
@@ -98,12 +105,12 @@ std::int64_t CsvReader::integer(std::size_t column) const {
       return v;
     case NumberStatus::kOutOfRange:
       fail(where(),
-           "column '" + columns_[column] + "': integer out of range: '" + std::string(f) + "'");
+           "column '" + column_name(column) + "': integer out of range: '" + std::string(f) + "'");
     default:
       break;
   }
   fail(where(),
-       "column '" + columns_[column] + "': expected an integer, got '" + std::string(f) + "'");
+       "column '" + column_name(column) + "': expected an integer, got '" + std::string(f) + "'");
 }
 
 }  // namespace mocap::formats_detail

@@ -25,6 +25,8 @@ class CsvReader {
   std::size_t line_number() const noexcept { return line_no_; }
   std::string where() const { return "line " + std::to_string(line_no_); }
 
+  // Whether the current row has this column (extension columns beyond the header's).
+  bool has_column(std::size_t column) const noexcept { return column < fields_.size(); }
   std::string_view text(std::size_t column) const;
   double number(std::size_t column) const;  // finite
   std::int64_t integer(std::size_t column) const;
@@ -33,6 +35,8 @@ class CsvReader {
   std::string content_;
   std::vector<std::string> columns_;
   std::vector<std::string_view> fields_;
+  // The header's name of a column, or its 1-based number beyond the header.
+  std::string column_name(std::size_t column) const;
   std::size_t pos_ = 0;
   std::size_t line_no_ = 0;
 };

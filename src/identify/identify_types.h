@@ -83,6 +83,7 @@ struct IdentifyConfig {
 struct BodyPose {
   bool found = false;
   bool from_prior = false;  // found by the temporal path (validated), not the full search
+  bool from_chain = false;  // solved through the kinematic chain (track/chain_solver.h)
   Iso3 T_world_body = Iso3::Identity();
   int markers = 0;      // matched markers m
   double rms_mm = 0.0;  // RMS residual of the least-squares fit over the m markers

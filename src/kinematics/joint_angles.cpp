@@ -63,6 +63,8 @@ bool JointAngleSolver::compute(const BodyPoseView* poses, JointAngles& out) noex
     const BodyPoseView& p = poses[j.parent];
     const BodyPoseView& c = poses[j.child];
     a.valid = p.found && c.found;
+    a.solved_by = a.valid ? client::SolvedBy::kPoses : client::SolvedBy::kNone;
+    a.sd_rad = {0.0, 0.0, 0.0};
     if (!a.valid) continue;
     const Mat3 R = p.T_world_body.linear().transpose() * c.T_world_body.linear();
     a.q_parent_child = canonical_quat(R);

@@ -12,8 +12,11 @@
 //    a1 = a2 = 0. Invalid frames (a body not found) keep the unwrapping state.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <vector>
+
+#include "client/joints_message.h"
 
 #include "core/expected.h"
 #include "core/types.h"
@@ -27,10 +30,15 @@ struct BodyPoseView {
 };
 
 struct JointAngle {
-  bool valid = false;  // both bodies found
+  bool valid = false;  // both bodies known (found, or solved through the kinematic chain)
   JointType type = JointType::kBall;
   double a0 = 0.0, a1 = 0.0, a2 = 0.0;     // rad
   Quat q_parent_child = Quat::Identity();  // R_parent^T R_child, qw >= 0
+  // How the angles were obtained (the public enum of the message) and their standard
+  // deviations (rad; hinge: a0 only). compute() sets kPoses and 0; chain tracking
+  // (track/chain_solver.h) fills both.
+  client::SolvedBy solved_by = client::SolvedBy::kNone;
+  std::array<double, 3> sd_rad{};
 };
 
 struct JointAngles {

@@ -167,6 +167,7 @@ Expected<SimSummary> write_simulated_recording(const SimOptions& options, const 
       row.type = j.type;
       row.angles_deg = joint_angles_rad(j, Tp, Tc) * kRadToDeg;
       row.q_parent_child = canonical_quat(Tp.linear().transpose() * Tc.linear());
+      row.solved_by = "truth";  // ground truth: exact, sd 0
       write_row(*angles_csv, row);
     }
     for (int m = 0; m < scene.marker_count(); ++m) {

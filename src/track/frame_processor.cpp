@@ -41,6 +41,20 @@ Expected<FrameProcessor> FrameProcessor::create(const Rig& rig, const TargetSet&
     return make_error(
         "tracker", "whole_marker_min_roundness_ratio",
         "must be in [0, 1], got " + std::to_string(config.whole_marker_min_roundness_ratio));
+  if (model != nullptr) {
+    auto chain_model = ChainModel::create(*model, targets);
+    if (!chain_model) return Error{"chain tracking: " + chain_model.error().message};
+    ChainConfig cc = config.chain;
+    const IdentifyConfig& ic = config.identify;
+    if (ic.point_sigma_mm > 0.0) cc.point_sigma_mm = ic.point_sigma_mm;
+    cc.partial_sigma_mm = ic.partial_sigma_mm;
+    cc.confidence = ic.consistency_confidence;
+    if (ic.max_angular_speed_deg_per_s > 0.0)
+      cc.max_angular_speed_deg_per_s = ic.max_angular_speed_deg_per_s;
+    auto chain = ChainSolver::create(std::move(chain_model).value(), cc);
+    if (!chain) return Error{"chain tracking: " + chain.error().message};
+    p.chain_.emplace(std::move(chain).value());
+  }
   p.whole_min_roundness_ratio_ = config.whole_marker_min_roundness_ratio;
   p.whole_min_area_px_ = config.whole_marker_min_area_px;
   for (auto& c : p.centroids_px_) c.resize(static_cast<std::size_t>(config.detect.max_blobs));
@@ -133,11 +147,21 @@ bool FrameProcessor::process_blobs(std::int64_t timestamp_ns, FrameOutput& out) 
   // Joint angles.
   t = now;
   if (angles_) {
+    track_chain(n_points, timestamp_ns, out);
     for (std::size_t b = 0; b < body_views_.size(); ++b) {
       body_views_[b].found = out.poses.bodies[b].found;
       body_views_[b].T_world_body = out.poses.bodies[b].T_world_body;
     }
     angles_->compute(body_views_.data(), out.angles);
+    if (chain_) {
+      for (std::size_t j = 0; j < out.angles.joints.size() && j < chain_result_.joints.size(); ++j) {
+        kinematics::JointAngle& a = out.angles.joints[j];
+        if (!a.valid) continue;
+        a.solved_by = chain_result_.joints[j].solved_by;
+        a.sd_rad = chain_result_.joints[j].sd_rad;
+      }
+      chain_->remember(out.poses, timestamp_ns);
+    }
   }
   out.times.angles = monotonic_ns() - t;
   return identified;
@@ -156,7 +180,29 @@ bool FrameProcessor::whole_marker_view(const detect::Blob& blob, const CameraMod
   return static_cast<double>(blob.roundness) >= whole_min_roundness_ratio_ * cos_theta;
 }
 
+void FrameProcessor::track_chain(int n_points, std::int64_t timestamp_ns,
+                                 FrameOutput& out) noexcept {
+  if (!chain_) return;
+  chain_->solve(measured_.data(), n_points, timestamp_ns, out.poses, chain_result_);
+  for (int b = 0; b < out.poses.count; ++b) {
+    const auto ub = static_cast<std::size_t>(b);
+    BodyPose& bp = out.poses.bodies[ub];
+    bp.from_chain = false;
+    if (!chain_result_.chain_body[ub]) continue;
+    bp.found = true;
+    bp.from_chain = true;
+    bp.from_prior = false;
+    bp.T_world_body = chain_result_.T_world_body[ub];
+    bp.markers = chain_result_.markers[ub];
+    bp.rms_mm = chain_result_.rms_mm[ub];
+    bp.score = 0.0;
+    bp.point_index_of_marker = chain_result_.point_index_of_marker[ub];
+    ++out.poses.found;
+  }
+}
+
 void FrameProcessor::reset() noexcept {
+  if (chain_) chain_->reset();
   identifier_.reset();
   if (angles_) angles_->reset();
 }

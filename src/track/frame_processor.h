@@ -22,6 +22,7 @@
 #include "identify/identifier.h"
 #include "kinematics/joint_angles.h"
 #include "stereo/stereo_triangulator.h"
+#include "track/chain_solver.h"
 
 namespace mocap {
 
@@ -46,6 +47,10 @@ struct TrackerConfig {
   // the roundness to tell (pixelisation): only their flags count.
   double whole_marker_min_roundness_ratio = 0.97;
   double whole_marker_min_area_px = 50.0;
+  // Kinematic-chain tracking, used whenever a model is loaded. Its point noise, partial
+  // noise, confidence and angular speed bound are taken from `identify` at create() (one
+  // source for each); the other keys are its own.
+  ChainConfig chain{};
 };
 
 // Wall-clock duration of each stage of one frame (ns). `detect` covers both cameras.
@@ -103,12 +108,18 @@ class FrameProcessor {
   }
   const StereoCounters& stereo_counters() const noexcept { return stereo_.counters(); }
   const IdentifyCounters& identify_counters() const noexcept { return identifier_.counters(); }
+  // Chain-tracking counters; null without a model.
+  const ChainCounters* chain_counters() const noexcept {
+    return chain_ ? &chain_->counters() : nullptr;
+  }
   const std::vector<std::string>& warnings() const noexcept { return identifier_.warnings(); }
 
  private:
   FrameProcessor(Rig rig, TargetSet targets, JointModel model,
                  std::array<detect::BlobDetector, 2> detectors, StereoTriangulator stereo,
                  Identifier identifier, std::optional<kinematics::JointAngleSolver> angles);
+  // Chain tracking after identification: chain-solved bodies join out.poses.
+  void track_chain(int n_points, std::int64_t timestamp_ns, FrameOutput& out) noexcept;
   // False when the blob of a marker at X_world does not look like a whole marker.
   bool whole_marker_view(const detect::Blob& blob, const CameraModel& cam,
                          const Vec3& X_world) const noexcept;
@@ -122,6 +133,8 @@ class FrameProcessor {
   StereoTriangulator stereo_;
   Identifier identifier_;
   std::optional<kinematics::JointAngleSolver> angles_;
+  std::optional<ChainSolver> chain_;
+  ChainResult chain_result_;
   // Workspace, sized at create().
   std::array<std::vector<Vec2>, 2> centroids_px_;
   std::vector<MeasuredPoint> measured_;

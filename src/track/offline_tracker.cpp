@@ -46,7 +46,8 @@ Expected<OfflineTrackResult> track_recording(const OfflineTrackOptions& opt) {
     const std::string& m = proc.error().message;
     if (m.rfind("rig: ", 0) == 0) return make_error(opt.recording_dir + "/rig.yaml", "cameras", m.substr(5));
     if (m.rfind("identification: ", 0) == 0) return make_error(opt.targets_path, "", m);
-    if (m.rfind("joint angles: ", 0) == 0) return make_error(opt.model_path, "", m);
+    if (m.rfind("joint angles: ", 0) == 0 || m.rfind("chain tracking: ", 0) == 0)
+      return make_error(opt.model_path, "", m);
     return make_error(opt.recording_dir, "", m);
   }
   for (const std::string& w : proc->warnings()) {
@@ -72,6 +73,11 @@ Expected<OfflineTrackResult> track_recording(const OfflineTrackOptions& opt) {
   result.stats = std::make_unique<TrackStats>(frames.size());
   for (const MarkerTarget& t : targets->bodies) result.body_names.push_back(t.name);
   result.body_found.assign(targets->bodies.size(), 0);
+  if (model) {
+    for (const JointSpec& j : model->joints) result.joint_names.push_back(j.name);
+    result.joint_poses.assign(model->joints.size(), 0);
+    result.joint_chain.assign(model->joints.size(), 0);
+  }
 
   FrameOutput out = proc->make_output();
   std::vector<char> used(static_cast<std::size_t>(out.points.capacity()), 0);
@@ -137,6 +143,12 @@ Expected<OfflineTrackResult> track_recording(const OfflineTrackOptions& opt) {
         angle_row.type = a.type;
         angle_row.angles_deg = Vec3(a.a0, a.a1, a.a2) * kRadToDeg;
         angle_row.q_parent_child = a.q_parent_child;
+        angle_row.solved_by = client::solved_by_name(a.solved_by);
+        if (a.solved_by == client::SolvedBy::kChain)
+          ++result.joint_chain[j];
+        else
+          ++result.joint_poses[j];
+        angle_row.sd_deg = Vec3(a.sd_rad[0], a.sd_rad[1], a.sd_rad[2]) * kRadToDeg;
         write_row(*angles_csv, angle_row);
         ++result.angle_rows;
       }
@@ -183,6 +195,17 @@ std::string format_track_summary(const OfflineTrackResult& r) {
                   static_cast<long long>(r.body_found[b]),
                   r.frames ? 100.0 * static_cast<double>(r.body_found[b]) / static_cast<double>(r.frames) : 0.0);
     s += buf;
+  }
+  if (!r.joint_names.empty()) {
+    s += "  joint coverage (share of frames with the angle valid):  valid    poses    chain\n";
+    const double n = r.frames > 0 ? static_cast<double>(r.frames) : 1.0;
+    for (std::size_t j = 0; j < r.joint_names.size(); ++j) {
+      const double p = 100.0 * static_cast<double>(r.joint_poses[j]) / n;
+      const double c = 100.0 * static_cast<double>(r.joint_chain[j]) / n;
+      std::snprintf(buf, sizeof buf, "    %-12s %41.1f%% %7.1f%% %7.1f%%\n",
+                    r.joint_names[j].c_str(), p + c, p, c);
+      s += buf;
+    }
   }
   if (r.stats) {
     const std::pair<const char*, const LatencyRecorder*> stages[] = {

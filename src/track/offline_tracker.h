@@ -39,6 +39,9 @@ struct OfflineTrackResult {
   std::vector<std::string> body_names;
   std::vector<std::int64_t> body_found;  // frames in which each body was found
   std::int64_t angle_rows = 0;
+  // Coverage per joint (model order): frames with the angle valid, by how it was solved.
+  std::vector<std::string> joint_names;
+  std::vector<std::int64_t> joint_poses, joint_chain;
   std::unique_ptr<TrackStats> stats;
   std::optional<AccuracyReport> accuracy;
 };

@@ -34,6 +34,21 @@ std::vector<std::pair<std::string, std::uint64_t>> collect_counters(const FrameP
   c.emplace_back("identify_velocity_rejects", i.velocity_rejects);
   c.emplace_back("identify_point_overflow", i.point_overflow);
   c.emplace_back("identify_node_limit_hits", i.node_limit_hits);
+  if (const ChainCounters* k = p.chain_counters()) {
+    c.emplace_back("chain_attempts", k->attempts);
+    c.emplace_back("chain_joints_solved", k->joints_solved);
+    c.emplace_back("chain_too_few_labels", k->too_few_labels);
+    c.emplace_back("chain_ambiguous_labels", k->ambiguous_labels);
+    c.emplace_back("chain_chi2_drops", k->chi2_drops);
+    c.emplace_back("chain_chi2_rejects", k->chi2_rejects);
+    c.emplace_back("chain_uncertain_rejects", k->uncertain_rejects);
+    c.emplace_back("chain_node_limit_hits", k->node_limit_hits);
+    for (std::size_t j = 0; j < p.model().joints.size() && j < k->joint_poses.size(); ++j) {
+      const std::string key = "coverage_" + p.model().joints[j].name + "_";
+      c.emplace_back(key + "poses", k->joint_poses[j]);
+      c.emplace_back(key + "chain", k->joint_chain[j]);
+    }
+  }
   return c;
 }
 

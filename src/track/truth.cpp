@@ -128,6 +128,7 @@ Expected<std::vector<AngleRow>> true_angles_from_poses(const TargetSet& targets,
       r.type = a.type;
       r.angles_deg = Vec3(a.a0, a.a1, a.a2) * kRadToDeg;
       r.q_parent_child = a.q_parent_child;
+      r.solved_by = "truth";
       rows.push_back(std::move(r));
     }
   }

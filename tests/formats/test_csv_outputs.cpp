@@ -56,6 +56,8 @@ std::vector<AngleRow> sample_angles() {
     r.type = i % 2 ? JointType::kHinge : JointType::kBall;
     r.angles_deg = i % 2 ? Vec3(12.3456789, 0, 0) : Vec3(-170.1, 45.000001, 3.3);
     r.q_parent_child = Quat(Eigen::AngleAxisd(2.5 * i, Vec3(0, 0.6, 0.8)));
+    r.solved_by = i == 0 ? "" : (i % 2 ? "chain" : "poses");
+    r.sd_deg = Vec3(0.25, 0.5, 0.125) * (i % 2 ? 1.0 : 0.5);
     rows.push_back(r);
   }
   return rows;
@@ -132,8 +134,10 @@ TEST_F(CsvOutputsTest, AnglesRoundTrip) {
     ASSERT_TRUE(f->close().ok());
   }
   const std::string text = test::read_file(path);
-  EXPECT_THAT(text, HasSubstr("frame,timestamp_ns,joint,type,a0,a1,a2,qw,qx,qy,qz\n0,5,shoulder,"
-                              "ball,-170.100000,45.000001,3.300000,"));
+  EXPECT_THAT(text, HasSubstr("frame,timestamp_ns,joint,type,a0,a1,a2,qw,qx,qy,qz,solved_by,sd_a0,"
+                              "sd_a1,sd_a2\n0,5,shoulder,ball,-170.100000,45.000001,3.300000,"));
+  // The extension columns: how each angle was solved and its standard deviations.
+  EXPECT_THAT(text, HasSubstr(",chain,0.250000,0.500000,0.125000\n"));
   EXPECT_THAT(text, HasSubstr("\n1,6,elbow,hinge,12.345679,0.000000,0.000000,"));
   auto back = read_angles_csv(path);
   ASSERT_TRUE(back.ok()) << back.error().message;
@@ -143,6 +147,8 @@ TEST_F(CsvOutputsTest, AnglesRoundTrip) {
     EXPECT_EQ(b.frame, rows[i].frame);
     EXPECT_EQ(b.timestamp_ns, rows[i].timestamp_ns);
     EXPECT_EQ(b.joint, rows[i].joint);
+    EXPECT_EQ(b.solved_by, rows[i].solved_by.empty() ? "none" : rows[i].solved_by);
+    EXPECT_NEAR((b.sd_deg - rows[i].sd_deg).norm(), 0.0, 1e-6);
     EXPECT_EQ(b.type, rows[i].type);
     EXPECT_NEAR((b.angles_deg - rows[i].angles_deg).cwiseAbs().maxCoeff(), 0.0, 5e-7);
     EXPECT_GE(b.q_parent_child.w(), 0.0);
