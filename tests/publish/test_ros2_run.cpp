@@ -4,7 +4,8 @@
 // /joint_states and /tf. Checked: at least 95 % of the frames the UDP datagrams carry
 // after the reader matched arrive on both topics, the joint positions are exactly the
 // datagrams' angles (frames aligned by capture time: stamp - capture_ns is one constant
-// offset), the names follow the URDF convention, and the run reports the ros2 counters.
+// offset), the names are the revolute joints of the URDF the tracker publishes on
+// /robot_description (transient local), and the run reports the ros2 counters.
 #include <arpa/inet.h>
 #include <dds/dds.h>
 #include <gtest/gtest.h>
@@ -59,7 +60,15 @@ TEST(Ros2Run, TrackerPublishesEveryFrameOnJointStatesAndTf) {
   const dds_entity_t tf = dds_create_reader(
       pp, dds_create_topic(pp, &tf2_msgs_msg_dds__TFMessage__desc, "rt/tf", nullptr, nullptr), qos,
       nullptr);
+  dds_qset_durability(qos, DDS_DURABILITY_TRANSIENT_LOCAL);
+  const dds_entity_t desc =
+      dds_create_reader(pp,
+                        dds_create_topic(pp, &std_msgs_msg_dds__String__desc,
+                                         "rt/robot_description", nullptr, nullptr),
+                        qos, nullptr);
   dds_delete_qos(qos);
+  ASSERT_GT(desc, 0);
+  std::string urdf;
   ASSERT_GT(js, 0);
   ASSERT_GT(tf, 0);
 
@@ -84,6 +93,14 @@ TEST(Ros2Run, TrackerPublishesEveryFrameOnJointStatesAndTf) {
   auto drain_dds = [&] {
     void* samples[32];
     dds_sample_info_t infos[32];
+    {
+      void* d[1] = {nullptr};
+      dds_sample_info_t di[1];
+      if (dds_take(desc, d, di, 1, 1) == 1) {
+        if (di[0].valid_data) urdf = static_cast<const std_msgs_msg_dds__String_*>(d[0])->data;
+        dds_return_loan(desc, d, 1);
+      }
+    }
     for (;;) {
       for (void*& s : samples) s = nullptr;
       const dds_return_t n = dds_take(js, samples, infos, 32, 32);
@@ -192,6 +209,10 @@ TEST(Ros2Run, TrackerPublishesEveryFrameOnJointStatesAndTf) {
     EXPECT_EQ(k, s.positions.size());
   }
   EXPECT_GT(compared, 0u);
+  // /robot_description (transient local): the URDF whose revolute joints name the states.
+  ASSERT_NE(urdf.find("<robot name=\"mocap_robot\">"), std::string::npos) << urdf.substr(0, 200);
+  for (const std::string& n : states.front().names)
+    EXPECT_NE(urdf.find("<joint name=\"" + n + "\" type=\"revolute\">"), std::string::npos) << n;
   const std::string json = test::read_file(stats);
   EXPECT_NE(json.find("output_ros2_published"), std::string::npos);
 }
