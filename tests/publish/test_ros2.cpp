@@ -6,6 +6,7 @@
 // positions equal to the datagram's float angles, invalid joints left out, one
 // transform per body found (parent "mocap", metres, x y z w), the stamp on
 // CLOCK_REALTIME. A reader that never takes does not slow publish() (drops counted).
+// DDS that cannot start gives one notice line and no sink (the tracker runs on).
 // Also: the pure mapping (names, ROS_DOMAIN_ID parsing, stamps).
 #include <dds/dds.h>
 #include <gtest/gtest.h>
@@ -14,6 +15,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <memory>
 #include <string>
 #include <thread>
@@ -185,6 +187,27 @@ TEST(Ros2Output, BadDomainIsOneLineNamingTheVariable) {
   ASSERT_FALSE(e.ok());
   EXPECT_EQ(e.error().message, "ROS_DOMAIN_ID: 'x7': expected an integer in 0..232");
   EXPECT_FALSE(check_outputs({{"ros2", {"perhaps"}, "--ros2", {}}}).ok());
+}
+
+TEST(Ros2Output, MissingDdsIsOneNoticeAndNoSink) {
+  // A DDS configuration naming a network interface that does not exist: the participant
+  // cannot be created, as on a machine without usable DDS networking.
+  ::setenv("CYCLONEDDS_URI",
+           "<CycloneDDS><Domain><General><Interfaces><NetworkInterface name=\"nosuchif0\"/>"
+           "</Interfaces></General></Domain></CycloneDDS>",
+           1);
+  Fixture fx;
+  OutputContext ctx;
+  ctx.targets = &fx.targets;
+  auto outs = create_outputs(
+      {{"ros2", {"true"}, "--ros2", {{"domain_id", std::to_string(test_domain(2))}}}}, ctx);
+  ::unsetenv("CYCLONEDDS_URI");
+  ASSERT_TRUE(outs.ok()) << outs.error().message;
+  EXPECT_TRUE(outs->sinks.empty());
+  ASSERT_EQ(outs->notices.size(), 1u);
+  EXPECT_EQ(outs->notices[0].rfind("ros2: DDS unavailable (dds_create_participant: ", 0), 0u)
+      << outs->notices[0];
+  EXPECT_EQ(outs->notices[0].find('\n'), std::string::npos);
 }
 
 TEST(Ros2Output, ReaderReceivesEveryMessageWithRos2NamesAndValues) {
