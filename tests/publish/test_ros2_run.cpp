@@ -1,5 +1,5 @@
-// `mocap run --ros2` end to end: the built tracker runs the simulated rig at 50 Hz for a
-// few seconds with UDP to this test and ROS 2 on a DDS domain of its own
+// `mocap run --ros2` end to end: the built tracker runs the simulated rig at 100 Hz for
+// 2 seconds with UDP to this test and ROS 2 on a DDS domain of its own
 // (ROS_DOMAIN_ID); a Cyclone DDS reader with the ROS 2 IDL and names receives
 // /joint_states and /tf. Checked: at least 95 % of the frames the UDP datagrams carry
 // after the reader matched arrive on both topics, the joint positions are exactly the
@@ -78,7 +78,7 @@ TEST(Ros2Run, TrackerPublishesEveryFrameOnJointStatesAndTf) {
   std::thread tracker([&] {
     run = test::run_command("ROS_DOMAIN_ID=" + std::to_string(domain) + " timeout -s KILL 60 " +
                             test::mocap_binary() +
-                            " run --ros2 --duration 4 --rate 50 --loop-frames 20 --no-realtime "
+                            " run --ros2 --duration 2 --rate 100 --loop-frames 4 --no-realtime "
                             "--no-iceoryx --stats-interval 0 --udp 127.0.0.1:" +
                             std::to_string(ntohs(a.sin_port)) + " --stats " + stats + " 2>&1");
   });
