@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <memory>
@@ -76,23 +77,42 @@ struct SimRigFixture {
 };
 
 // Stores up to `capacity` messages; optional sleep per publish (a slow transport).
-class RecordingSink final : public JointsSink {
+class RecordingSink final : public publish::OutputSink {
  public:
   explicit RecordingSink(std::size_t capacity, int sleep_us = 0)
       : messages_(capacity), sleep_us_(sleep_us) {}
-  bool publish(const client::JointsMessage& m) noexcept override {
+  const char* name() const noexcept override { return "recording"; }
+  publish::OutputCounters counters() const noexcept override { return {}; }
+  bool publish(const publish::FrameResult& frame) noexcept override {
+    const client::JointsMessage& m = frame.joints;
     if (sleep_us_ > 0) std::this_thread::sleep_for(std::chrono::microseconds(sleep_us_));
     const std::size_t n = count_.load(std::memory_order_relaxed);  // single writer
     if (n >= messages_.size()) return false;
     messages_[n] = m;
+    ResultSummary& r = results_[n];
+    r.body_count = frame.body_count;
+    r.marker_count = frame.marker_count;
+    r.point_count = frame.point_count;
+    r.bodies_found = 0;
+    for (int b = 0; b < frame.body_count; ++b) r.bodies_found += frame.bodies[b].found;
+    r.body0_found = frame.body_count > 0 && frame.bodies[0].found != 0;
+    r.t0_mm = frame.bodies[0].t_world_body_mm;
     count_.store(n + 1, std::memory_order_release);  // publishes messages_[n]
     return true;
   }
   std::size_t count() const noexcept { return count_.load(std::memory_order_acquire); }
   const client::JointsMessage& operator[](std::size_t i) const { return messages_[i]; }
+  // What the rest of the FrameResult carried (bodies, labelled markers, points).
+  struct ResultSummary {
+    int body_count = 0, bodies_found = 0, marker_count = 0, point_count = 0;
+    bool body0_found = false;
+    std::array<double, 3> t0_mm{};
+  };
+  const ResultSummary& result(std::size_t i) const { return results_[i]; }
 
  private:
   std::vector<client::JointsMessage> messages_;
+  std::vector<ResultSummary> results_ = std::vector<ResultSummary>(messages_.size());
   std::atomic<std::size_t> count_{0};
   int sleep_us_ = 0;
 };

@@ -70,6 +70,19 @@ TEST(Pipeline, PublishesFramesInOrderWithTrueAngles) {
       }
     }
     all_valid += valid ? 1 : 0;
+    // The rest of the frame's result reached the sink too (the output seam).
+    const RecordingSink::ResultSummary& res = sink.result(i);
+    EXPECT_EQ(res.body_count, static_cast<int>(scene.targets.bodies.size()));
+    if ((m.flags & client::kFlagAllBodiesFound) != 0) {
+      EXPECT_EQ(res.bodies_found, res.body_count);
+      EXPECT_GE(res.marker_count, 3 * res.body_count);
+      EXPECT_GE(res.point_count, res.marker_count);
+    }
+    if (res.body0_found) {
+      const Vec3 t = truth.T_world_body[0].translation();
+      EXPECT_NEAR(res.t0_mm[0], t.x(), 3.0);
+      EXPECT_NEAR(res.t0_mm[2], t.z(), 3.0);
+    }
   }
   // Some loop frames of the scenario are not fully identified (the same ones every
   // cycle, deterministic in lockstep: 56 of 120 complete here; a pose resting on partial

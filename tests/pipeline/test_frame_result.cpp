@@ -1,0 +1,102 @@
+// make_frame_result: from a hand-built FrameOutput (two bodies, one found, four 3D
+// points, a ball and a hinge joint) to the FrameResult every sink receives: joints as
+// the datagram expects them (validity, angles, quality solved-by), the found body's pose
+// as qw>=0 quaternion + translation, its labelled markers with the residual to the
+// posed model marker (unmatched markers left out), the points with reprojection error
+// and camera count; no allocation.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+
+#include "pipeline/frame_result_builder.h"
+#include "tests/support/alloc_counter.h"
+
+namespace mocap::pipeline {
+namespace {
+
+TEST(FrameResultBuilder, JointsPosesLabelledMarkersAndPoints) {
+  TargetSet targets;
+  for (const char* n : {"upper_arm", "forearm"}) {
+    MarkerTarget t;
+    t.name = n;
+    t.markers_body = {Vec3(0, 0, 0), Vec3(40, 0, 0), Vec3(0, 50, 0)};
+    targets.bodies.push_back(t);
+  }
+  auto out = std::make_unique<FrameOutput>();
+  out->points.set_capacity(8);
+  Iso3 T = Iso3::Identity();
+  T.translate(Vec3(100, 200, 1500));
+  T.rotate(Eigen::AngleAxisd(M_PI / 2, Vec3::UnitZ()));
+  // Points 0..2: markers 0, 2 of body 0 (1 mm off in x for marker 2), a stray; 3: no.
+  const Vec3 p0 = T * targets.bodies[0].markers_body[0];
+  const Vec3 p2 = T * targets.bodies[0].markers_body[2] + Vec3(1, 0, 0);
+  for (const Vec3& X : {p0, Vec3(5, 5, 5), p2}) {
+    Point3 p;
+    p.X_world = X;
+    p.reproj_px = 0.25;
+    p.blob_index = {3, 4, -1, -1};
+    ASSERT_TRUE(out->points.push_back(p));
+  }
+  out->poses.count = 2;
+  out->poses.found = 1;
+  BodyPose& b0 = out->poses.bodies[0];
+  b0.found = true;
+  b0.T_world_body = T;
+  b0.markers = 2;
+  b0.rms_mm = 0.7;
+  b0.point_index_of_marker.fill(-1);
+  b0.point_index_of_marker[0] = 0;
+  b0.point_index_of_marker[2] = 2;
+  out->poses.bodies[1].found = false;
+  out->angles.joints.resize(2);
+  out->angles.joints[0].valid = true;
+  out->angles.joints[0].type = JointType::kBall;
+  out->angles.joints[0].a0 = 0.1;
+  out->angles.joints[0].a1 = -0.2;
+  out->angles.joints[0].a2 = 0.3;
+  out->angles.joints[1].valid = false;
+  out->angles.joints[1].type = JointType::kHinge;
+
+  auto r = std::make_unique<publish::FrameResult>();
+  {
+    test::AllocationScope scope;
+    make_frame_result(7, 123456, targets, *out, *r);
+    EXPECT_EQ(scope.count(), 0u);
+  }
+  EXPECT_EQ(r->joints.sequence, 7u);
+  EXPECT_EQ(r->joints.capture_ns, 123456);
+  EXPECT_EQ(r->joints.flags, 0u);  // one body of two
+  ASSERT_EQ(r->joints.joint_count, 2);
+  EXPECT_EQ(r->joints.joints[0].valid, 1);
+  EXPECT_FLOAT_EQ(r->joints.joints[0].a[1], -0.2f);
+  EXPECT_EQ(r->joints.joints[1].valid, 0);
+  EXPECT_EQ(r->joints.joints[1].type, static_cast<std::uint8_t>(client::JointKind::kHinge));
+  EXPECT_EQ(r->joints.quality[0].solved_by, static_cast<std::uint8_t>(client::SolvedBy::kPoses));
+  EXPECT_EQ(r->joints.quality[1].solved_by, static_cast<std::uint8_t>(client::SolvedBy::kNone));
+
+  ASSERT_EQ(r->body_count, 2);
+  EXPECT_EQ(r->bodies[0].found, 1);
+  EXPECT_EQ(r->bodies[0].markers, 2);
+  EXPECT_FLOAT_EQ(r->bodies[0].rms_mm, 0.7f);
+  EXPECT_NEAR(r->bodies[0].q_world_body[0], std::sqrt(0.5), 1e-12);  // qw
+  EXPECT_NEAR(r->bodies[0].q_world_body[3], std::sqrt(0.5), 1e-12);  // qz
+  EXPECT_DOUBLE_EQ(r->bodies[0].t_world_body_mm[2], 1500.0);
+  EXPECT_EQ(r->bodies[1].found, 0);
+
+  ASSERT_EQ(r->marker_count, 2);
+  EXPECT_EQ(r->markers[0].body, 0);
+  EXPECT_EQ(r->markers[0].marker, 0);
+  EXPECT_NEAR(r->markers[0].residual_mm, 0.0f, 1e-4f);
+  EXPECT_EQ(r->markers[1].marker, 2);
+  EXPECT_NEAR(r->markers[1].residual_mm, 1.0f, 1e-4f);
+  EXPECT_FLOAT_EQ(r->markers[1].X_world_mm[0], static_cast<float>(p2.x()));
+
+  ASSERT_EQ(r->point_count, 3);
+  EXPECT_FLOAT_EQ(r->points[1].X_world_mm[1], 5.0f);
+  EXPECT_FLOAT_EQ(r->points[1].reproj_px, 0.25f);
+  EXPECT_EQ(r->points[1].cameras, 2);
+}
+
+}  // namespace
+}  // namespace mocap::pipeline
