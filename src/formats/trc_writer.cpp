@@ -1,0 +1,113 @@
+// Design: see trc_writer.h. Coordinates with 6 decimals (as markers.csv), so a TRC value
+// equals the markers.csv value exactly as text.
+#include "formats/trc_writer.h"
+
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+
+namespace mocap {
+namespace {
+
+constexpr std::size_t kCellChars = 32;  // one "%.6f" cell of a coordinate + tab, bounded
+
+}  // namespace
+
+Expected<TrcWriter> TrcWriter::open(const std::string& path, const TrajectoryLayout& l) {
+  if (l.labels.empty()) return make_error(path, "NumMarkers", "no markers to export");
+  if (!(l.rate_hz > 0.0) || !std::isfinite(l.rate_hz))
+    return make_error(path, "DataRate", "frame rate must be positive");
+  for (const std::string& s : l.labels) {
+    if (s.find_first_of("\t\r\n") != std::string::npos)
+      return make_error(path, "markers", "label '" + s + "' contains a tab or line break");
+  }
+  TrcWriter w;
+  w.path_ = path;
+  errno = 0;
+  w.file_.reset(std::fopen(path.c_str(), "w"));
+  if (!w.file_) return make_error(path, "cannot write", std::strerror(errno));
+  std::string head =
+      "PathFileType\t4\t(X/Y/Z)\t" + std::filesystem::path(path).filename().string() + "\n";
+  head +=
+      "DataRate\tCameraRate\tNumFrames\tNumMarkers\tUnits\tOrigDataRate\tOrigDataStartFrame\tOrigNu"
+      "mFrames\n";
+  char buf[256];
+  std::snprintf(buf, sizeof buf, "%.6f\t%.6f\t%lld\t%zu\tmm\t%.6f\t%lld\t%lld\n", l.rate_hz,
+                l.rate_hz, static_cast<long long>(l.frame_count), l.labels.size(), l.rate_hz,
+                static_cast<long long>(l.first_frame), static_cast<long long>(l.frame_count));
+  head += buf;
+  head += "Frame#\tTime";
+  for (const std::string& s : l.labels) head += "\t" + s + "\t\t";
+  head += "\n\t";
+  for (std::size_t i = 1; i <= l.labels.size(); ++i) {
+    const std::string n = std::to_string(i);
+    head += "\tX" + n + "\tY" + n + "\tZ" + n;
+  }
+  head += "\n\n";
+  if (std::fputs(head.c_str(), w.file_.get()) < 0)
+    return make_error(path, "cannot write", std::strerror(errno));
+  w.markers_ = l.labels.size();
+  w.line_.assign(64 + 3 * kCellChars * w.markers_, '\0');
+  w.frames_declared_ = l.frame_count;
+  return w;
+}
+
+bool TrcWriter::write_frame(std::int64_t frame_number, double time_s,
+                            const TrajectorySample* samples) noexcept {
+  if (failed_ || !file_) return false;
+  char* p = line_.data();
+  char* const end = line_.data() + line_.size();
+  int n = std::snprintf(p, static_cast<std::size_t>(end - p), "%lld\t%.6f",
+                        static_cast<long long>(frame_number), time_s);
+  p += n;
+  for (std::size_t i = 0; i < markers_; ++i) {
+    const TrajectorySample& s = samples[i];
+    if (!s.valid) {
+      n = std::snprintf(p, static_cast<std::size_t>(end - p), "\t\t\t");
+    } else {
+      // Coordinates beyond +-1e9 mm are not physical; clamp so the cell stays bounded.
+      const auto c = [](double v) {
+        return std::isfinite(v) ? std::fmax(-1e9, std::fmin(1e9, v)) : 0.0;
+      };
+      n = std::snprintf(p, static_cast<std::size_t>(end - p), "\t%.6f\t%.6f\t%.6f", c(s.X_mm.x()),
+                        c(s.X_mm.y()), c(s.X_mm.z()));
+    }
+    if (n < 0 || n >= end - p) {
+      failed_ = true;
+      write_errno_ = EOVERFLOW;
+      return false;
+    }
+    p += n;
+  }
+  *p++ = '\n';
+  const auto len = static_cast<std::size_t>(p - line_.data());
+  if (std::fwrite(line_.data(), 1, len, file_.get()) != len) {
+    failed_ = true;
+    write_errno_ = errno;
+    return false;
+  }
+  ++frames_written_;
+  return true;
+}
+
+Expected<void> TrcWriter::close() {
+  if (!file_) return {};
+  std::FILE* f = file_.release();
+  if (!failed_ && (std::fflush(f) != 0 || std::ferror(f) != 0)) {
+    failed_ = true;
+    write_errno_ = errno;
+  }
+  const int close_errno = std::fclose(f) != 0 ? errno : 0;
+  if (failed_ || close_errno != 0) {
+    return make_error(path_, "cannot write", std::strerror(failed_ ? write_errno_ : close_errno));
+  }
+  if (frames_written_ != frames_declared_) {
+    return make_error(path_, "NumFrames",
+                      "wrote " + std::to_string(frames_written_) + " frames, declared " +
+                          std::to_string(frames_declared_));
+  }
+  return {};
+}
+
+}  // namespace mocap
