@@ -94,11 +94,16 @@ void print_csv(const client::JointsMessage& m, std::uint64_t gap, double age_ms,
   }
 }
 
-// A JSON number, or null for NaN/infinity (JSON has neither).
-std::string json_number(double v, const char* fmt = "%.9g") {
+// A JSON number (9 significant digits, or 3 decimals when `millis`), or null for
+// NaN/infinity (JSON has neither).
+std::string json_number(double v, bool millis = false) {
   if (!std::isfinite(v)) return "null";
   char buf[48];
-  std::snprintf(buf, sizeof buf, fmt, v);
+  if (millis) {
+    std::snprintf(buf, sizeof buf, "%.3f", v);
+  } else {
+    std::snprintf(buf, sizeof buf, "%.9g", v);
+  }
   return buf;
 }
 
@@ -112,7 +117,7 @@ void print_json(const client::JointsMessage& m, std::uint64_t gap, double age_ms
   std::string s =
       "{\"seq\":" + std::to_string(m.sequence) + ",\"capture_ns\":" + std::to_string(m.capture_ns) +
       ",\"publish_ns\":" + std::to_string(m.publish_ns) +
-      ",\"age_ms\":" + json_number(age_ms, "%.3f") + ",\"gap\":" + std::to_string(gap) +
+      ",\"age_ms\":" + json_number(age_ms, true) + ",\"gap\":" + std::to_string(gap) +
       ",\"flags\":" + std::to_string(m.flags) +
       ",\"all_bodies_found\":" + ((m.flags & client::kFlagAllBodiesFound) ? "true" : "false") +
       ",\"joints\":[";

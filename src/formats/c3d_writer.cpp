@@ -70,8 +70,8 @@ class ParameterSection {
   // Strings padded with blanks to the longest: dimensions (length, count).
   void text(int group, const std::string& name, const std::vector<std::string>& values,
             const std::string& description) {
-    std::size_t len = 1;
-    for (const std::string& v : values) len = std::max(len, v.size());
+    std::size_t len = 1;  // a dimension is one byte: longer strings are cut at 255
+    for (const std::string& v : values) len = std::min<std::size_t>(255, std::max(len, v.size()));
     std::vector<unsigned char> data;
     for (const std::string& v : values) {
       std::string padded = v;

@@ -152,6 +152,8 @@ def check_c3d(path, markers, frames_csv, labels):
         word = int(w)
         if word != w or word <= 0:
             fail("frame %d %s: residual word %r is not a valid sample" % (frame, label, w))
+        if bin((word >> 8) & 0x7F).count("1") < 2:
+            fail("frame %d %s: camera mask %#x has fewer than 2 cameras" % (frame, label, word >> 8))
         residual = (word & 0xFF) * scale
         if abs(residual - max(res, scale)) > scale / 2 + 1e-6 and not (res > 255 * scale):
             fail("frame %d %s: residual %f vs markers.csv %f" % (frame, label, residual, res))
