@@ -82,10 +82,12 @@ def live_check(python_dir, mocap):
     port = free_udp_port()
     env = dict(os.environ, PYTHONPATH=python_dir)
     client = subprocess.Popen([sys.executable, "-m", "mocap_client", "--host", "127.0.0.1",
-                               "--port", str(port), "--duration", "8", "--count", "60"],
+                               "--port", str(port), "--duration", "40", "--count", "60"],
                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
     time.sleep(0.5)  # let it bind before the tracker sends
-    run = subprocess.run([mocap, "run", "--duration", "2", "--udp", "127.0.0.1:%d" % port],
+    # --loop-frames 10: the simulated cameras pre-render 10 frames (not 200) before starting.
+    run = subprocess.run([mocap, "run", "--duration", "2", "--udp", "127.0.0.1:%d" % port,
+                          "--loop-frames", "10", "--no-iceoryx", "--stats-interval", "0"],
                          capture_output=True, text=True, timeout=60)
     if run.returncode != 0:
         client.kill()

@@ -1,6 +1,7 @@
 """python3 -m mocap_client [--host H] [--port N] [--count N] [--duration S]
 
-Prints the received joint angles as CSV on stdout, one row per joint and message:
+Prints every received message's joint angles as CSV on stdout, one row per joint and
+message (gap: frames dropped just before that message):
 seq,capture_ns,age_ms,gap,flags,joint,type,valid,a0_deg,a1_deg,a2_deg,qw,qx,qy,qz
 (the columns of `mocap echo --format csv` without its quality columns, which the UDP
 datagram v1 does not carry). A summary of the counters goes to stderr at the end.
@@ -47,17 +48,20 @@ def main(argv=None):
     print(HEADER, flush=True)
     t0 = time.monotonic()
     printed = 0
+    def on_message(msg, gap):
+        nonlocal printed
+        if a.count and printed >= a.count:
+            return
+        age_ms = (time.monotonic_ns() - msg.capture_ns) * 1e-6
+        sys.stdout.write("".join(r + "\n" for r in rows(msg, age_ms, gap)))
+        printed += 1
+
     try:
         while not stop and (a.count == 0 or printed < a.count):
             if a.duration and time.monotonic() - t0 >= a.duration:
                 break
-            if not rx.wait(0.05):
-                continue
-            msg = rx.latest()
-            age_ms = rx.age_s() * 1e3
-            sys.stdout.write("".join(r + "\n" for r in rows(msg, age_ms, rx.gap())))
-            sys.stdout.flush()
-            printed += 1
+            if rx.wait(0.05, on_message):
+                sys.stdout.flush()
     except KeyboardInterrupt:
         pass
     finally:

@@ -107,17 +107,24 @@ class Receiver:
         self._latest = m
         return True
 
-    def poll(self):
-        """Reads every pending datagram without blocking; returns how many were accepted."""
+    def poll(self, on_message=None):
+        """Reads every pending datagram without blocking; returns how many were accepted.
+
+        on_message(message, gap), if given, is called for every accepted message in order
+        (gap: frames dropped just before it), not only for the newest.
+        """
         accepted = 0
         while True:
             try:
                 data = self._sock.recv(_MAX_DATAGRAM + 1)
             except (BlockingIOError, InterruptedError):
                 return accepted
-            accepted += 1 if self.feed(data) else 0
+            if self.feed(data):
+                accepted += 1
+                if on_message is not None:
+                    on_message(self._latest, self._last_gap)
 
-    def wait(self, timeout_s):
+    def wait(self, timeout_s, on_message=None):
         """Waits up to timeout_s for data, then polls; returns how many were accepted."""
         ready, _, _ = select.select([self._sock], [], [], max(0.0, timeout_s))
-        return self.poll() if ready else 0
+        return self.poll(on_message) if ready else 0
