@@ -36,7 +36,10 @@ def main():
     ap.add_argument("--build", required=True)
     ap.add_argument("--source", required=True)
     ap.add_argument("--cxx", required=True)
+    ap.add_argument("--sanitize", default="", help="MOCAP_SANITIZE of the build (a;b)")
     a = ap.parse_args()
+    # A sanitizer build's library is instrumented: the consumer must link the same runtime.
+    san = ["-fsanitize=" + a.sanitize.replace(";", ",")] if a.sanitize else []
     consumer = os.path.join(a.source, "tests", "client", "consumer")
     with tempfile.TemporaryDirectory(prefix="mocap_consumer_") as tmp:
         prefix = os.path.join(tmp, "prefix")
@@ -58,7 +61,8 @@ def main():
         # 1. find_package
         bdir = os.path.join(tmp, "build_cmake")
         run([a.cmake, "-S", consumer, "-B", bdir, "-DCMAKE_PREFIX_PATH=" + prefix,
-             "-DCMAKE_CXX_COMPILER=" + a.cxx, "-DCMAKE_BUILD_TYPE=Release"])
+             "-DCMAKE_CXX_COMPILER=" + a.cxx, "-DCMAKE_BUILD_TYPE=Release",
+             "-DCMAKE_CXX_FLAGS=" + " ".join(san)])
         run([a.cmake, "--build", bdir])
         out = run([os.path.join(bdir, "consumer")])
         if "consumer ok" not in out:
@@ -70,7 +74,7 @@ def main():
         if prefix not in flags and os.path.realpath(prefix) not in flags:
             fail("pkg-config flags do not point into the prefix: %s" % flags)
         exe = os.path.join(tmp, "consumer_pc")
-        run([a.cxx, "-std=c++20", "-O1", os.path.join(consumer, "main.cpp"), "-o", exe]
+        run([a.cxx, "-std=c++20", "-O1"] + san + [os.path.join(consumer, "main.cpp"), "-o", exe]
             + shlex.split(flags))
         out = run([exe])
         if "consumer ok" not in out:
