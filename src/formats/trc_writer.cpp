@@ -29,9 +29,8 @@ Expected<TrcWriter> TrcWriter::open(const std::string& path, const TrajectoryLay
   if (!w.file_) return make_error(path, "cannot write", std::strerror(errno));
   std::string head =
       "PathFileType\t4\t(X/Y/Z)\t" + std::filesystem::path(path).filename().string() + "\n";
-  head +=
-      "DataRate\tCameraRate\tNumFrames\tNumMarkers\tUnits\tOrigDataRate\tOrigDataStartFrame\tOrigNu"
-      "mFrames\n";
+  head += "DataRate\tCameraRate\tNumFrames\tNumMarkers\tUnits\t";
+  head += "OrigDataRate\tOrigDataStartFrame\tOrigNumFrames\n";
   char buf[256];
   std::snprintf(buf, sizeof buf, "%.6f\t%.6f\t%lld\t%zu\tmm\t%.6f\t%lld\t%lld\n", l.rate_hz,
                 l.rate_hz, static_cast<long long>(l.frame_count), l.labels.size(), l.rate_hz,
