@@ -2,13 +2,16 @@
 // labelled list (label_markers) and writing one frame to markers.csv (always written: the
 // same-run baseline), to C3D and to TRC, for 3 bodies x 5 markers (the built-in scene has
 // 5, 5, 4), all seen, and for a large 16 x 15 target set. Files go to /tmp (page cache), so this
-// is the CPU cost of formatting and buffered writing, not of the disk.
+// is the CPU cost of formatting and buffered writing, not of the disk. BM_FormatRow
+// compares printf with the std::to_chars formatting the text writers use.
 #include <benchmark/benchmark.h>
 
+#include <cstdio>
 #include <memory>
 #include <string>
 
 #include "formats/c3d_writer.h"
+#include "formats/fixed_text.h"
 #include "formats/markers_csv.h"
 #include "formats/trc_writer.h"
 #include "track/labelled_markers.h"
@@ -83,6 +86,36 @@ BENCHMARK(BM_LabelledFrame)
     ->Args({0, 16, 15})
     ->Args({1, 16, 15})
     ->Args({2, 16, 15});
+
+// One markers.csv row into a buffer: printf's "%.6f" (kind 0, the same-run baseline, what
+// the writers used before) vs std::to_chars (kind 1, what they use now). Same digits.
+void BM_FormatRow(benchmark::State& state) {
+  char buf[256];
+  double x = 1234.567891, y = -87.654321, z = 15.0001, r = 0.012345;
+  for (auto _ : state) {
+    if (state.range(0) == 0) {
+      benchmark::DoNotOptimize(std::snprintf(buf, sizeof buf,
+                                             "%lld,%lld,%s,%d,%.6f,%.6f,%.6f,%.6f\n", 1234LL,
+                                             12340000000LL, "upper_arm", 3, x, y, z, r));
+    } else {
+      using namespace mocap::formats_detail;
+      char* const end = buf + sizeof buf;
+      char* p = put_int(buf, end, 1234);
+      p = put_text(p, end, ",");
+      p = put_int(p, end, 12340000000LL);
+      p = put_text(p, end, ",upper_arm,");
+      p = put_int(p, end, 3);
+      for (double v : {x, y, z, r}) {
+        p = put_text(p, end, ",");
+        p = put_fixed(p, end, v, 6);
+      }
+      benchmark::DoNotOptimize(put_text(p, end, "\n"));
+    }
+    benchmark::ClobberMemory();
+    x += 1e-6;  // new digits every row
+  }
+}
+BENCHMARK(BM_FormatRow)->ArgName("to_chars")->Arg(0)->Arg(1);
 
 }  // namespace
 

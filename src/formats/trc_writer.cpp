@@ -1,5 +1,5 @@
-// Design: see trc_writer.h. Coordinates with 6 decimals (as markers.csv), so a TRC value
-// equals the markers.csv value exactly as text.
+// Design: see trc_writer.h. Coordinates with 6 decimals (as markers.csv, both through
+// std::to_chars: fixed_text.h), so a TRC value equals the markers.csv value exactly as text.
 #include "formats/trc_writer.h"
 
 #include <cerrno>
@@ -7,10 +7,15 @@
 #include <cstring>
 #include <filesystem>
 
+#include "formats/fixed_text.h"
+
 namespace mocap {
+
+using namespace formats_detail;
+
 namespace {
 
-constexpr std::size_t kCellChars = 32;  // one "%.6f" cell of a coordinate + tab, bounded
+constexpr std::size_t kCellChars = 32;  // one 6-decimal cell of a coordinate + tab, bounded
 
 }  // namespace
 
@@ -55,31 +60,29 @@ Expected<TrcWriter> TrcWriter::open(const std::string& path, const TrajectoryLay
 bool TrcWriter::write_frame(std::int64_t frame_number, double time_s,
                             const TrajectorySample* samples) noexcept {
   if (failed_ || !file_) return false;
-  char* p = line_.data();
   char* const end = line_.data() + line_.size();
-  int n = std::snprintf(p, static_cast<std::size_t>(end - p), "%lld\t%.6f",
-                        static_cast<long long>(frame_number), time_s);
-  p += n;
-  for (std::size_t i = 0; i < markers_; ++i) {
+  char* p = put_int(line_.data(), end, frame_number);
+  p = put_text(p, end, "\t");
+  p = put_fixed(p, end, std::isfinite(time_s) ? time_s : 0.0, 6);
+  for (std::size_t i = 0; i < markers_ && p; ++i) {
     const TrajectorySample& s = samples[i];
     if (!s.valid) {
-      n = std::snprintf(p, static_cast<std::size_t>(end - p), "\t\t\t");
-    } else {
+      p = put_text(p, end, "\t\t\t");
+      continue;
+    }
+    for (int k = 0; k < 3; ++k) {
       // Coordinates beyond +-1e9 mm are not physical; clamp so the cell stays bounded.
-      const auto c = [](double v) {
-        return std::isfinite(v) ? std::fmax(-1e9, std::fmin(1e9, v)) : 0.0;
-      };
-      n = std::snprintf(p, static_cast<std::size_t>(end - p), "\t%.6f\t%.6f\t%.6f", c(s.X_mm.x()),
-                        c(s.X_mm.y()), c(s.X_mm.z()));
+      const double v = s.X_mm[k];
+      p = put_text(p, end, "\t");
+      p = put_fixed(p, end, std::isfinite(v) ? std::fmax(-1e9, std::fmin(1e9, v)) : 0.0, 6);
     }
-    if (n < 0 || n >= end - p) {
-      failed_ = true;
-      write_errno_ = EOVERFLOW;
-      return false;
-    }
-    p += n;
   }
-  *p++ = '\n';
+  p = put_text(p, end, "\n");
+  if (!p) {
+    failed_ = true;
+    write_errno_ = EOVERFLOW;
+    return false;
+  }
   const auto len = static_cast<std::size_t>(p - line_.data());
   if (std::fwrite(line_.data(), 1, len, file_.get()) != len) {
     failed_ = true;

@@ -3,10 +3,13 @@
 // failure is one line naming the file; the per-frame calls allocate nothing.
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <random>
 
 #include "formats/c3d_writer.h"
+#include "formats/fixed_text.h"
 #include "formats/trc_writer.h"
 #include "tests/support/alloc_counter.h"
 #include "track/labelled_markers.h"
@@ -85,6 +88,25 @@ TEST(FrameRate, MedianStepPerFrameNumberAndErrors) {
       frame_rate_hz(std::vector<FrameEntry>{FrameEntry{0, 5}, FrameEntry{1, 5}}, "rec/frames.csv");
   ASSERT_FALSE(back.ok());
   EXPECT_NE(back.error().message.find("frame 1"), std::string::npos) << back.error().message;
+}
+
+TEST(FixedText, SameDigitsAsPrintf) {
+  // The text writers format with to_chars; markers.csv and TRC must read as "%.6f" did.
+  std::vector<double> values{0.0, -0.0, 0.0078125, -0.0078125, 2.5e-7,        -4e-7,
+                             1e9, -1e9, 123.4565,  0.1234565,  999999.9999995};
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(-5000.0, 5000.0);
+  for (int i = 0; i < 20000; ++i) values.push_back(u(rng));
+  for (double v : values) {
+    char expected[64], got[64];
+    std::snprintf(expected, sizeof expected, "%.6f", v);
+    char* end = formats_detail::put_fixed(got, got + sizeof got - 1, v, 6);
+    ASSERT_NE(end, nullptr);
+    *end = '\0';
+    ASSERT_STREQ(got, expected) << v;
+  }
+  char small[4];
+  EXPECT_EQ(formats_detail::put_fixed(small, small + sizeof small, 1234.5, 6), nullptr);
 }
 
 TrajectoryLayout layout(std::int64_t frames, std::int64_t first = 1) {
