@@ -193,15 +193,10 @@ Expected<C3dWriter> C3dWriter::open(const std::string& path, const TrajectoryLay
     const std::string& m = head.error().message;
     return make_error(path, "", m.substr(std::min(m.size(), std::string("C3D: ").size())));
   }
-  C3dWriter w;
-  w.path_ = path;
-  errno = 0;
-  w.file_.reset(std::fopen(path.c_str(), "wb"));
-  if (!w.file_) return make_error(path, "cannot write", std::strerror(errno));
-  if (std::fwrite(head->data(), 1, head->size(), w.file_.get()) != head->size()) {
-    return make_error(path, "cannot write", std::strerror(errno));
-  }
-  w.bytes_written_ = head->size();
+  auto file = formats_detail::ExportFile::open(path);
+  if (!file) return file.error();
+  C3dWriter w(std::move(file).value());
+  w.file_.write(head->data(), head->size());  // a failure is reported by close()
   w.points_ = layout.labels.size();
   w.frame_bytes_.assign(16 * w.points_, 0);
   w.frames_declared_ = layout.frame_count;
@@ -209,7 +204,7 @@ Expected<C3dWriter> C3dWriter::open(const std::string& path, const TrajectoryLay
 }
 
 bool C3dWriter::write_frame(const TrajectorySample* samples) noexcept {
-  if (failed_ || !file_) return false;
+  if (file_.failed()) return false;
   const float scale = std::fabs(kC3dPointScale);
   for (std::size_t i = 0; i < points_; ++i) {
     const TrajectorySample& s = samples[i];
@@ -229,38 +224,17 @@ bool C3dWriter::write_frame(const TrajectorySample* samples) noexcept {
     set_f32(frame_bytes_, at + 8, static_cast<float>(s.X_mm.z()));
     set_f32(frame_bytes_, at + 12, static_cast<float>(word));
   }
-  if (std::fwrite(frame_bytes_.data(), 1, frame_bytes_.size(), file_.get()) !=
-      frame_bytes_.size()) {
-    failed_ = true;
-    write_errno_ = errno;
-    return false;
-  }
-  bytes_written_ += frame_bytes_.size();
+  if (!file_.write(frame_bytes_.data(), frame_bytes_.size())) return false;
   ++frames_written_;
   return true;
 }
 
 Expected<void> C3dWriter::close() {
-  if (!file_) return {};
-  std::FILE* f = file_.release();
-  if (!failed_) {
-    const std::size_t pad = (kBlock - bytes_written_ % kBlock) % kBlock;
-    static const unsigned char kZeros[kBlock] = {};
-    if (std::fwrite(kZeros, 1, pad, f) != pad) {
-      failed_ = true;
-      write_errno_ = errno;
-    }
-  }
-  if (!failed_ && (std::fflush(f) != 0 || std::ferror(f) != 0)) {
-    failed_ = true;
-    write_errno_ = errno;
-  }
-  const int close_errno = std::fclose(f) != 0 ? errno : 0;
-  if (failed_ || close_errno != 0) {
-    return make_error(path_, "cannot write", std::strerror(failed_ ? write_errno_ : close_errno));
-  }
+  static const unsigned char kZeros[kBlock] = {};
+  file_.write(kZeros, (kBlock - file_.bytes_written() % kBlock) % kBlock);  // whole blocks
+  if (auto r = file_.close(); !r) return r;
   if (frames_written_ != frames_declared_) {
-    return make_error(path_, "POINT:FRAMES",
+    return make_error(file_.path(), "POINT:FRAMES",
                       "wrote " + std::to_string(frames_written_) + " frames, declared " +
                           std::to_string(frames_declared_));
   }

@@ -11,12 +11,12 @@
 #pragma once
 
 #include <cstdint>
-#include <cstdio>
-#include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/expected.h"
+#include "formats/export_file.h"
 #include "formats/trajectory_export.h"
 
 namespace mocap {
@@ -36,24 +36,15 @@ class C3dWriter {
   // Pads the file to whole 512-byte blocks, flushes and closes. An error when a write
   // failed or fewer/more frames were written than the layout declared.
   Expected<void> close();
-  const std::string& path() const noexcept { return path_; }
+  const std::string& path() const noexcept { return file_.path(); }
 
  private:
-  C3dWriter() = default;
-  struct Closer {
-    void operator()(std::FILE* f) const noexcept {
-      if (f) std::fclose(f);
-    }
-  };
-  std::unique_ptr<std::FILE, Closer> file_;
-  std::string path_;
+  explicit C3dWriter(formats_detail::ExportFile file) : file_(std::move(file)) {}
+  formats_detail::ExportFile file_;
   std::vector<unsigned char> frame_bytes_;  // one frame, sized at open
   std::size_t points_ = 0;
   std::int64_t frames_declared_ = 0;
   std::int64_t frames_written_ = 0;
-  std::uint64_t bytes_written_ = 0;
-  int write_errno_ = 0;  // first failure
-  bool failed_ = false;
 };
 
 // The header block and parameter section of a C3D file for `layout` (exposed for tests).

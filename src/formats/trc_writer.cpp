@@ -27,11 +27,9 @@ Expected<TrcWriter> TrcWriter::open(const std::string& path, const TrajectoryLay
     if (s.find_first_of("\t\r\n") != std::string::npos)
       return make_error(path, "markers", "label '" + s + "' contains a tab or line break");
   }
-  TrcWriter w;
-  w.path_ = path;
-  errno = 0;
-  w.file_.reset(std::fopen(path.c_str(), "w"));
-  if (!w.file_) return make_error(path, "cannot write", std::strerror(errno));
+  auto file = ExportFile::open(path);
+  if (!file) return file.error();
+  TrcWriter w(std::move(file).value());
   std::string head =
       "PathFileType\t4\t(X/Y/Z)\t" + std::filesystem::path(path).filename().string() + "\n";
   head += "DataRate\tCameraRate\tNumFrames\tNumMarkers\tUnits\t";
@@ -49,8 +47,7 @@ Expected<TrcWriter> TrcWriter::open(const std::string& path, const TrajectoryLay
     head += "\tX" + n + "\tY" + n + "\tZ" + n;
   }
   head += "\n\n";
-  if (std::fputs(head.c_str(), w.file_.get()) < 0)
-    return make_error(path, "cannot write", std::strerror(errno));
+  w.file_.write(head.data(), head.size());  // a failure is reported by close()
   w.markers_ = l.labels.size();
   w.line_.assign(64 + 3 * kCellChars * w.markers_, '\0');
   w.frames_declared_ = l.frame_count;
@@ -59,7 +56,7 @@ Expected<TrcWriter> TrcWriter::open(const std::string& path, const TrajectoryLay
 
 bool TrcWriter::write_frame(std::int64_t frame_number, double time_s,
                             const TrajectorySample* samples) noexcept {
-  if (failed_ || !file_) return false;
+  if (file_.failed()) return false;
   char* const end = line_.data() + line_.size();
   char* p = put_int(line_.data(), end, frame_number);
   p = put_text(p, end, "\t");
@@ -79,33 +76,18 @@ bool TrcWriter::write_frame(std::int64_t frame_number, double time_s,
   }
   p = put_text(p, end, "\n");
   if (!p) {
-    failed_ = true;
-    write_errno_ = EOVERFLOW;
+    file_.fail(EOVERFLOW);
     return false;
   }
-  const auto len = static_cast<std::size_t>(p - line_.data());
-  if (std::fwrite(line_.data(), 1, len, file_.get()) != len) {
-    failed_ = true;
-    write_errno_ = errno;
-    return false;
-  }
+  if (!file_.write(line_.data(), static_cast<std::size_t>(p - line_.data()))) return false;
   ++frames_written_;
   return true;
 }
 
 Expected<void> TrcWriter::close() {
-  if (!file_) return {};
-  std::FILE* f = file_.release();
-  if (!failed_ && (std::fflush(f) != 0 || std::ferror(f) != 0)) {
-    failed_ = true;
-    write_errno_ = errno;
-  }
-  const int close_errno = std::fclose(f) != 0 ? errno : 0;
-  if (failed_ || close_errno != 0) {
-    return make_error(path_, "cannot write", std::strerror(failed_ ? write_errno_ : close_errno));
-  }
+  if (auto r = file_.close(); !r) return r;
   if (frames_written_ != frames_declared_) {
-    return make_error(path_, "NumFrames",
+    return make_error(file_.path(), "NumFrames",
                       "wrote " + std::to_string(frames_written_) + " frames, declared " +
                           std::to_string(frames_declared_));
   }

@@ -9,12 +9,12 @@
 #pragma once
 
 #include <cstdint>
-#include <cstdio>
-#include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/expected.h"
+#include "formats/export_file.h"
 #include "formats/trajectory_export.h"
 
 namespace mocap {
@@ -32,20 +32,12 @@ class TrcWriter {
   Expected<void> close();
 
  private:
-  TrcWriter() = default;
-  struct Closer {
-    void operator()(std::FILE* f) const noexcept {
-      if (f) std::fclose(f);
-    }
-  };
-  std::unique_ptr<std::FILE, Closer> file_;
-  std::string path_;
+  explicit TrcWriter(formats_detail::ExportFile file) : file_(std::move(file)) {}
+  formats_detail::ExportFile file_;
   std::vector<char> line_;  // one frame's line, sized at open
   std::size_t markers_ = 0;
   std::int64_t frames_declared_ = 0;
   std::int64_t frames_written_ = 0;
-  int write_errno_ = 0;
-  bool failed_ = false;
 };
 
 }  // namespace mocap
