@@ -1,13 +1,17 @@
 // `mocap echo [--udp HOST:PORT] [--multicast-if ADDR] [--iceoryx] [--count N]
-// [--duration S]`: prints the live joint angles that `mocap run` publishes, received
-// through the client library exactly as a motor controller would (client/udp_receiver.h,
-// client/iceoryx_subscriber.h). One line per received message on stdout: sequence number,
-// age (now - trigger time, CLOCK_MONOTONIC: meaningful when tracker and echo share a
-// machine), the sequence gap since the previous message (frames dropped on the way) and
-// every joint's angles in degrees. --count / --duration stop it; SIGINT/SIGTERM stop it
-// cleanly (the handler only sets an atomic flag; RouDi also SIGTERMs its clients when it
-// shuts down). A summary line goes to stderr at the end. Setup failures (port in use,
-// RouDi absent, bad address) are one line and exit code 2.
+// [--duration S] [--format text|csv|json]`: prints the live joint angles that `mocap run`
+// publishes, received through the client library exactly as a motor controller would
+// (client/udp_receiver.h, client/iceoryx_subscriber.h). One line per received message on stdout:
+// sequence number, age (now - trigger time, CLOCK_MONOTONIC: meaningful when tracker and echo share
+// a machine), the sequence gap since the previous message (frames dropped on the way) and every
+// joint's angles in degrees. --format csv prints a header and one row per joint and message (angles
+// in degrees, as the spec's CSV files), --format json one JSON object per message and line
+// (radians); both end with the joint's quality (solved_by and the standard deviations of the
+// angles; see docs/client.md) where the transport carries it (iceoryx; the UDP datagram v1 does
+// not: empty/null). --count / --duration stop it; SIGINT/SIGTERM stop it cleanly (the handler only
+// sets an atomic flag; RouDi also SIGTERMs its clients when it shuts down). A summary line goes to
+// stderr at the end. Setup failures (port in use, RouDi absent, bad address) are one line and exit
+// code 2.
 #include <signal.h>
 #include <unistd.h>
 
@@ -44,12 +48,105 @@ struct EchoArgs {
   bool iceoryx = false;
   long long count = 0;      // 0: unlimited
   double duration_s = 0.0;  // 0: until SIGINT/SIGTERM
+  std::string format = "text";
 };
 
 constexpr double kRadToDeg = 180.0 / M_PI;
 
-void print_message(const client::JointsMessage& m, std::uint64_t gap) {
+constexpr const char* kCsvHeader =
+    "seq,capture_ns,age_ms,gap,flags,joint,type,valid,a0_deg,a1_deg,a2_deg,qw,qx,qy,qz,"
+    "solved_by,sd0_deg,sd1_deg,sd2_deg";
+
+const char* solved_by_name(std::uint8_t s) {
+  switch (static_cast<client::SolvedBy>(s)) {
+    case client::SolvedBy::kNone:
+      return "none";
+    case client::SolvedBy::kPoses:
+      return "poses";
+    case client::SolvedBy::kChain:
+      return "chain";
+  }
+  return "unknown";
+}
+
+// `quality`: false when the transport does not carry JointQuality (UDP datagram v1): the
+// quality columns are then empty (csv) or null (json), never a made-up value.
+void print_csv(const client::JointsMessage& m, std::uint64_t gap, double age_ms, bool quality) {
+  for (std::size_t j = 0; j < m.joint_count && j < client::kMaxJoints; ++j) {
+    const client::JointRecord& r = m.joints[j];
+    const client::JointQuality& q = m.quality[j];
+    const bool hinge = r.type == static_cast<std::uint8_t>(client::JointKind::kHinge);
+    char tail[128] = ",,,";
+    if (quality) {
+      std::snprintf(tail, sizeof tail, "%s,%.6f,%.6f,%.6f", solved_by_name(q.solved_by),
+                    static_cast<double>(q.sd_rad[0]) * kRadToDeg,
+                    static_cast<double>(q.sd_rad[1]) * kRadToDeg,
+                    static_cast<double>(q.sd_rad[2]) * kRadToDeg);
+    }
+    std::printf("%llu,%lld,%.3f,%llu,%u,%u,%s,%u,%.6f,%.6f,%.6f,%.9f,%.9f,%.9f,%.9f,%s\n",
+                static_cast<unsigned long long>(m.sequence), static_cast<long long>(m.capture_ns),
+                age_ms, static_cast<unsigned long long>(gap), static_cast<unsigned>(m.flags),
+                static_cast<unsigned>(r.index), hinge ? "hinge" : "ball",
+                static_cast<unsigned>(r.valid), static_cast<double>(r.a[0]) * kRadToDeg,
+                static_cast<double>(r.a[1]) * kRadToDeg, static_cast<double>(r.a[2]) * kRadToDeg,
+                static_cast<double>(r.q[0]), static_cast<double>(r.q[1]),
+                static_cast<double>(r.q[2]), static_cast<double>(r.q[3]), tail);
+  }
+}
+
+// A JSON number (9 significant digits, or 3 decimals when `millis`), or null for
+// NaN/infinity (JSON has neither).
+std::string json_number(double v, bool millis = false) {
+  if (!std::isfinite(v)) return "null";
+  char buf[48];
+  if (millis) {
+    std::snprintf(buf, sizeof buf, "%.3f", v);
+  } else {
+    std::snprintf(buf, sizeof buf, "%.9g", v);
+  }
+  return buf;
+}
+
+std::string json_array(const float* v, int n) {
+  std::string s = "[";
+  for (int i = 0; i < n; ++i) s += (i ? "," : "") + json_number(static_cast<double>(v[i]));
+  return s + "]";
+}
+
+void print_json(const client::JointsMessage& m, std::uint64_t gap, double age_ms, bool quality) {
+  std::string s =
+      "{\"seq\":" + std::to_string(m.sequence) + ",\"capture_ns\":" + std::to_string(m.capture_ns) +
+      ",\"publish_ns\":" + std::to_string(m.publish_ns) +
+      ",\"age_ms\":" + json_number(age_ms, true) + ",\"gap\":" + std::to_string(gap) +
+      ",\"flags\":" + std::to_string(m.flags) +
+      ",\"all_bodies_found\":" + ((m.flags & client::kFlagAllBodiesFound) ? "true" : "false") +
+      ",\"joints\":[";
+  for (std::size_t j = 0; j < m.joint_count && j < client::kMaxJoints; ++j) {
+    const client::JointRecord& r = m.joints[j];
+    const client::JointQuality& q = m.quality[j];
+    const bool hinge = r.type == static_cast<std::uint8_t>(client::JointKind::kHinge);
+    s += std::string(j ? "," : "") + "{\"index\":" + std::to_string(r.index) + ",\"type\":\"" +
+         (hinge ? "hinge" : "ball") + "\",\"valid\":" + (r.valid ? "true" : "false") +
+         ",\"a_rad\":" + json_array(r.a, 3) + ",\"q\":" + json_array(r.q, 4) + ",\"solved_by\":" +
+         (quality ? "\"" + std::string(solved_by_name(q.solved_by)) + "\"" : std::string("null")) +
+         ",\"sd_rad\":" + (quality ? json_array(q.sd_rad, 3) : std::string("null")) + "}";
+  }
+  s += "]}\n";
+  std::fputs(s.c_str(), stdout);
+}
+
+void print_message(const client::JointsMessage& m, std::uint64_t gap, const std::string& format,
+                   bool quality) {
   const double age_ms = static_cast<double>(monotonic_ns() - m.capture_ns) * 1e-6;
+  if (format != "text") {
+    if (format == "csv") {
+      print_csv(m, gap, age_ms, quality);
+    } else {
+      print_json(m, gap, age_ms, quality);
+    }
+    std::fflush(stdout);
+    return;
+  }
   std::printf("seq %llu age %.3f ms gap %llu%s", static_cast<unsigned long long>(m.sequence),
               age_ms, static_cast<unsigned long long>(gap),
               (m.flags & client::kFlagAllBodiesFound) ? "" : " (bodies missing)");
@@ -101,7 +198,7 @@ int echo_udp(const EchoArgs& a) {
     const std::uint64_t gap = c.dropped_frames - last_dropped;
     last_accepted = c.accepted;
     last_dropped = c.dropped_frames;
-    print_message(rx->latest(), gap);
+    print_message(rx->latest(), gap, a.format, false);
     ++printed;
   }
   const client::ReceiverCounters& c = rx->counters();
@@ -133,7 +230,7 @@ int echo_iceoryx(const EchoArgs& a) {
     const client::SubscriberCounters& c = (*sub)->counters();
     const std::uint64_t gap = c.dropped_frames - last_dropped;
     last_dropped = c.dropped_frames;
-    print_message(m, gap);
+    print_message(m, gap, a.format, true);
     ++printed;
   }
   const client::SubscriberCounters& c = (*sub)->counters();
@@ -151,6 +248,10 @@ int echo_iceoryx(const EchoArgs& a) {
 int run_echo(const EchoArgs& a) {
   if (a.count < 0) return fail("--count: must be >= 0");
   if (a.duration_s < 0.0) return fail("--duration: must be >= 0");
+  if (a.format == "csv") {
+    std::printf("%s\n", kCsvHeader);
+    std::fflush(stdout);
+  }
   struct sigaction sa {};
   sa.sa_handler = on_echo_signal;
   sigemptyset(&sa.sa_mask);
@@ -171,6 +272,10 @@ void register_echo(CLI::App& app, int& exit_code) {
                 "Read from iceoryx shared memory (needs iox-roudi) instead of UDP");
   cmd->add_option("--count", args->count, "Stop after printing N messages (default: no limit)");
   cmd->add_option("--duration", args->duration_s, "Stop after S seconds (default: until Ctrl-C)");
+  cmd->add_option("--format", args->format,
+                  "Output: text (default), csv (one row per joint, degrees) or json (one "
+                  "object per message and line, radians)")
+      ->check(CLI::IsMember({"text", "csv", "json"}));
   cmd->callback([args, &exit_code] { exit_code = run_echo(*args); });
 }
 

@@ -3,7 +3,8 @@
 // stages as the live pipeline (src/track). --truth (extension) compares the outputs
 // with the simulator's ground truth and prints the accuracy. --config (extension) takes
 // the detection, stereo and identification thresholds from a `mocap run` configuration
-// file (its other sections are validated but not used).
+// file (its other sections are validated but not used). markers.csv is always written;
+// --c3d FILE and --trc FILE (spec extension) export the labelled trajectories.
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -17,7 +18,7 @@ namespace mocap::app {
 namespace {
 
 struct TrackArgs {
-  std::string recording, targets, model, out, stats, truth, config;
+  std::string recording, targets, model, out, stats, truth, config, c3d, trc;
   bool quiet = false;
 };
 
@@ -29,6 +30,8 @@ int run_track(const TrackArgs& a) {
   opt.out_dir = a.out;
   opt.stats_path = a.stats;
   opt.truth_dir = a.truth;
+  opt.c3d_path = a.c3d;
+  opt.trc_path = a.trc;
   if (!a.config.empty()) {
     auto cfg = config::load_run_config(a.config);
     if (!cfg) return fail(cfg.error().message);
@@ -56,7 +59,8 @@ void register_track(CLI::App& app, int& exit_code) {
   auto args = std::make_shared<TrackArgs>();
   CLI::App* cmd = app.add_subcommand(
       "track",
-      "Track a recording offline: writes points.csv, poses.csv and (with --model) angles.csv");
+      "Track a recording offline: writes points.csv, poses.csv, markers.csv and (with --model) "
+      "angles.csv");
   cmd->add_option("recording", args->recording,
                   "Recording folder (rig.yaml, frames.csv, cam0/, cam1/)")
       ->required();
@@ -65,6 +69,10 @@ void register_track(CLI::App& app, int& exit_code) {
                   "Calibrated joint model (model.yaml): enables angles.csv");
   cmd->add_option("--out", args->out, "Output folder")->required();
   cmd->add_option("--stats", args->stats, "Write per-stage latency statistics to this JSON file");
+  cmd->add_option("--c3d", args->c3d,
+                  "Also write the labelled marker trajectories as C3D (float, mm) to this file");
+  cmd->add_option("--trc", args->trc,
+                  "Also write the labelled marker trajectories as OpenSim TRC to this file");
   cmd->add_option("--truth", args->truth,
                   "Ground-truth folder of a simulated recording (REC/gt): print accuracy");
   cmd->add_option(

@@ -9,6 +9,8 @@
 #include "formats/joints_yaml.h"
 #include "formats/recording.h"
 #include "formats/targets_yaml.h"
+#include "track/labelled_markers.h"
+#include "track/trajectory_export.h"
 
 namespace mocap {
 namespace {
@@ -67,6 +69,10 @@ Expected<OfflineTrackResult> track_recording(const OfflineTrackOptions& opt) {
     if (!a) return a.error();
     angles_csv.emplace(std::move(a).value());
   }
+  auto exports = LabelledExports::open({opt.out_dir + "/markers.csv", opt.c3d_path, opt.trc_path},
+                                       *targets, rec->frames(), opt.recording_dir + "/frames.csv");
+  if (!exports) return exports.error();
+  auto labelled = std::make_unique<LabelledMarkers>();
 
   const auto& frames = rec->frames();
   OfflineTrackResult result;
@@ -153,6 +159,8 @@ Expected<OfflineTrackResult> track_recording(const OfflineTrackOptions& opt) {
         ++result.angle_rows;
       }
     }
+    label_markers(out, *targets, *labelled);
+    if (!exports->write_frame(fi, *labelled)) break;  // close() below names the file
     if (opt.progress) opt.progress(static_cast<std::int64_t>(fi + 1), static_cast<std::int64_t>(frames.size()));
   }
 
@@ -161,6 +169,8 @@ Expected<OfflineTrackResult> track_recording(const OfflineTrackOptions& opt) {
   if (angles_csv) {
     if (auto r = angles_csv->close(); !r) return r.error();
   }
+  if (auto r = exports->close(); !r) return r.error();
+  result.marker_rows = exports->marker_rows();
   result.stats->counters = collect_counters(*proc);
   if (!opt.stats_path.empty()) {
     if (auto r = write_stats_json(opt.stats_path, *result.stats); !r) return r.error();

@@ -1,7 +1,8 @@
 // Design: `mocap track` as a library call: runs a recording through the FrameProcessor
 // frame by frame (files are read outside the timed region) and writes the spec's
-// points.csv, poses.csv, angles.csv and optionally stats.json. A missing frame file is
-// a dropped frame (no 3D points for that frame); a damaged one is reported as a warning
+// points.csv, poses.csv, angles.csv, markers.csv (labelled markers) and optionally
+// stats.json and the labelled trajectories as C3D and TRC (trajectory_export.h). A missing frame
+// file is a dropped frame (no 3D points for that frame); a damaged one is reported as a warning
 // naming the file and treated as dropped, so one bad file never loses the rest.
 #pragma once
 
@@ -25,6 +26,8 @@ struct OfflineTrackOptions {
   std::string model_path;  // empty: no joint angles
   std::string out_dir;
   std::string stats_path;  // empty: no stats.json
+  std::string c3d_path;    // empty: no C3D export
+  std::string trc_path;    // empty: no TRC export
   std::string truth_dir;   // empty: no accuracy report (simulator ground truth, e.g. REC/gt)
   TrackerConfig config{};
   std::function<void(std::int64_t done, std::int64_t total)> progress;
@@ -42,6 +45,7 @@ struct OfflineTrackResult {
   // Coverage per joint (model order): frames with the angle valid, by how it was solved.
   std::vector<std::string> joint_names;
   std::vector<std::int64_t> joint_poses, joint_chain;
+  std::int64_t marker_rows = 0;  // rows of markers.csv (labelled markers)
   std::unique_ptr<TrackStats> stats;
   std::optional<AccuracyReport> accuracy;
 };

@@ -7,6 +7,8 @@
 #include <filesystem>
 
 #include "formats/csv_outputs.h"
+#include "formats/markers_csv.h"
+#include "formats/targets_yaml.h"
 #include "formats/recording.h"
 #include "tests/track/track_fixture.h"
 #include "track/offline_tracker.h"
@@ -91,6 +93,43 @@ TEST(OfflineTracker, WritesTheSpecFilesAndStats) {
                           "\"angles\"", "\"frame\"", "\"p50_us\"", "\"p99_us\"", "\"max_us\""}) {
     EXPECT_NE(stats.find(key), std::string::npos) << key;
   }
+}
+
+TEST(OfflineTracker, MarkersCsvLabelsTheMarkersOfEveryPose) {
+  sim::SimOptions so;
+  so.frames = 12;
+  so.stray = 3;
+  const std::string& rec = test::simulated_recording("alloc", so);
+  test::TempDir out("track_markers");
+  OfflineTrackResult r = track_or_fail(rec, out.path(), false);
+  EXPECT_EQ(test::read_file(out.file("markers.csv"))
+                .rfind("frame,timestamp_ns,body,marker,x,y,z,residual_mm\n", 0),
+            0u);
+  auto markers = read_markers_csv(out.file("markers.csv"));
+  auto poses = read_poses_csv(out.file("poses.csv"));
+  auto targets = load_targets(rec + "/targets.yaml");
+  ASSERT_TRUE(markers.ok() && poses.ok() && targets.ok());
+  EXPECT_EQ(r.marker_rows, static_cast<std::int64_t>(markers->size()));
+  std::size_t matched = 0;
+  for (const PoseRow& p : *poses) {
+    const MarkerTarget& t = targets->bodies[static_cast<std::size_t>(targets->index_of(p.body))];
+    int rows = 0;
+    for (const MarkerRow& m : *markers) {
+      if (m.frame != p.frame || m.body != p.body) continue;
+      ++rows;
+      EXPECT_EQ(m.timestamp_ns, p.timestamp_ns);
+      ASSERT_LT(m.marker, static_cast<int>(t.markers_body.size()));
+      // The residual is the distance to the posed model marker (poses.csv's pose).
+      const Vec3 predicted =
+          p.q_world_body * t.markers_body[static_cast<std::size_t>(m.marker)] + p.t_world_body;
+      EXPECT_NEAR(m.residual_mm, (m.X_world - predicted).norm(), 1e-4);
+      EXPECT_LT(m.residual_mm, 5.0);
+    }
+    EXPECT_EQ(rows, p.markers) << "frame " << p.frame << " " << p.body;
+    matched += static_cast<std::size_t>(rows);
+  }
+  EXPECT_EQ(matched, markers->size());  // no row without a pose
+  EXPECT_GE(markers->size(), 12u * 8u);
 }
 
 TEST(OfflineTracker, MissingAndDamagedFramesAreDroppedNotFatal) {
