@@ -96,27 +96,32 @@ Expected<void> RecordingFiles::write_image(int camera, std::int64_t frame, const
                                        image.height, static_cast<int>(image.maxval));
   const std::size_t row_bytes = static_cast<std::size_t>(image.width) * (wide ? 2u : 1u);
   const std::size_t data_bytes = row_bytes * static_cast<std::size_t>(image.height);
-  if (header_len <= 0 || data_bytes + static_cast<std::size_t>(header_len) > scratch_.size())
+  if (header_len <= 0 || data_bytes > scratch_.size())
     return make_error(path, "", "image larger than the recorder's slots");
-  // Header and pixels in one buffer, one write (16-bit: big-endian on disk).
-  std::uint8_t* out = scratch_.data();
-  std::memcpy(out, header, static_cast<std::size_t>(header_len));
-  std::uint8_t* px = out + header_len;
-  for (int y = 0; y < image.height; ++y) {
-    std::uint8_t* dst = px + static_cast<std::size_t>(y) * row_bytes;
-    if (!wide) {
-      std::memcpy(dst, image.row8(y), row_bytes);
-    } else {
-      const std::uint16_t* s16 = image.row16(y);
-      for (int x = 0; x < image.width; ++x) {
-        dst[2 * static_cast<std::size_t>(x)] = static_cast<std::uint8_t>(s16[x] >> 8);
-        dst[2 * static_cast<std::size_t>(x) + 1] = static_cast<std::uint8_t>(s16[x] & 0xff);
+  // 8-bit rows packed in memory are written straight from the image (no copy); 16-bit
+  // pixels are swapped to big-endian into the scratch buffer.
+  const std::uint8_t* pixels = image.data;
+  if (wide || image.stride_bytes != static_cast<int>(row_bytes)) {
+    std::uint8_t* px = scratch_.data();
+    for (int y = 0; y < image.height; ++y) {
+      std::uint8_t* dst = px + static_cast<std::size_t>(y) * row_bytes;
+      if (!wide) {
+        std::memcpy(dst, image.row8(y), row_bytes);
+      } else {
+        const std::uint16_t* s16 = image.row16(y);
+        for (int x = 0; x < image.width; ++x) {
+          dst[2 * static_cast<std::size_t>(x)] = static_cast<std::uint8_t>(s16[x] >> 8);
+          dst[2 * static_cast<std::size_t>(x) + 1] = static_cast<std::uint8_t>(s16[x] & 0xff);
+        }
       }
     }
+    pixels = px;
   }
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) return io_error(path, "cannot write", errno);
-  const bool ok = write_all(fd, out, data_bytes + static_cast<std::size_t>(header_len));
+  const bool ok = write_all(fd, reinterpret_cast<const std::uint8_t*>(header),
+                            static_cast<std::size_t>(header_len)) &&
+                  write_all(fd, pixels, data_bytes);
   const int err = errno;
   const bool closed = ::close(fd) == 0;
   if (!ok || !closed) {
