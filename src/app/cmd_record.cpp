@@ -195,8 +195,14 @@ int record(const RecordArgs& a) {
     return kExitWriteFailed;
   }
   if (const int sig = g_record_signal.load(std::memory_order_relaxed); sig != 0) {
-    std::fprintf(stderr, "mocap record: stopped by %s: %s is a valid recording\n",
-                 sig == SIGINT ? "SIGINT" : "SIGTERM", a.out.c_str());
+    if (k.frames_written > 0) {
+      std::fprintf(stderr, "mocap record: stopped by %s: %s is a valid recording\n",
+                   sig == SIGINT ? "SIGINT" : "SIGTERM", a.out.c_str());
+    } else {
+      std::fprintf(stderr,
+                   "mocap record: stopped by %s before the first frame: %s holds no frame\n",
+                   sig == SIGINT ? "SIGINT" : "SIGTERM", a.out.c_str());
+    }
   }
   return 0;
 }

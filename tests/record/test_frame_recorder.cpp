@@ -3,12 +3,15 @@
 // formats/recording.h (the reader of `mocap track`).
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <filesystem>
+#include <thread>
 
 #include "formats/recording.h"
 #include "formats/rig_yaml.h"
 #include "pipeline/record/frame_recorder.h"
 #include "pipeline/record/recording_assets.h"
+#include "tests/support/alloc_counter.h"
 #include "tests/support/test_support.h"
 
 namespace mocap::record {
@@ -126,6 +129,26 @@ TEST(FrameRecorder, DropsAndCountsWhenTheWriterIsBehind) {
   auto r = Recording::open(dir.path());
   ASSERT_TRUE(r) << r.error().message;
   EXPECT_EQ(r->frames().size(), 8u);  // camera 0 only (camera 1 never delivered)
+}
+
+TEST(FrameRecorder, TheTapAllocatesNothing) {
+  test::TempDir dir("rec_alloc");
+  write_rig(dir.path());
+  auto rec = FrameRecorder::create(options(dir.path()));
+  ASSERT_TRUE(rec);
+  (*rec)->start();
+  const Image a = pattern(0, 0), b = pattern(1, 0);
+  std::uint64_t allocations = 0;
+  for (std::uint64_t s = 0; s < 40; ++s) {  // slots taken, copied, freed by the writer
+    test::AllocationScope scope;
+    (*rec)->on_frame(0, frame_of(a, s));
+    (*rec)->on_frame(1, frame_of(b, s));
+    allocations += scope.count();
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  EXPECT_EQ(allocations, 0u);
+  ASSERT_TRUE((*rec)->finish());
+  EXPECT_GT((*rec)->counts().frames_written, 0u);
 }
 
 TEST(FrameRecorder, OutOfOrderPairingStillWritesIncreasingFrames) {
