@@ -101,6 +101,7 @@ void Pipeline::capture_loop() noexcept {
           break;
         }
         on_frame_received(c, f, last_trigger_ns);
+        if (options_.tap != nullptr) options_.tap->on_frame(c, f);
         if (!triggered_mode && c == 0) k.triggered.add();
         last_sequence = f.sequence;
         if (to_detect_[static_cast<std::size_t>(c)]->try_push(f)) {

@@ -70,6 +70,17 @@ class FrameObserver {
                        const FrameOutput& out) noexcept = 0;
 };
 
+// Called on the capture thread with every frame a camera delivered (missing replay frames
+// included), right after it was dequeued and before it goes to its detector: `mocap
+// record` copies the images here (pipeline/record). Must be noexcept, allocation-free and
+// return quickly (periodic pacing: it must never wait; lockstep pacing may wait briefly,
+// as the trigger does).
+class FrameTap {
+ public:
+  virtual ~FrameTap() = default;
+  virtual void on_frame(int camera, const hal::Frame& frame) noexcept = 0;
+};
+
 // Called on each stage thread right before its loop starts and right after it ends
 // (tests count the thread's heap allocations in between).
 class StageHooks {
@@ -95,6 +106,7 @@ struct PipelineOptions {
   std::int64_t pair_tolerance_us = 1000;
   FrameObserver* observer = nullptr;
   StageHooks* hooks = nullptr;
+  FrameTap* tap = nullptr;  // `mocap record`: every delivered frame, capture thread
 };
 
 // A cheap view of the running pipeline for a supervisor (systemd watchdog, status line):

@@ -126,14 +126,14 @@ hal::CameraConfig camera_config(const config::CameraSettings& s, hal::CameraConf
   return base;
 }
 
-void say(std::FILE* log, const std::string& line) {
-  if (log != nullptr) std::fprintf(log, "mocap run: %s\n", line.c_str());
+void say(std::FILE* log, const std::string& line, const char* command = "mocap run") {
+  if (log != nullptr) std::fprintf(log, "%s: %s\n", command, line.c_str());
 }
 
 }  // namespace
 
-Expected<std::unique_ptr<LiveSetup>> LiveSetup::create(const config::RunConfig& cfg,
-                                                       std::FILE* log) {
+Expected<std::unique_ptr<LiveSetup>> LiveSetup::create(const config::RunConfig& cfg, std::FILE* log,
+                                                       const char* command) {
   std::unique_ptr<LiveSetup> s(new LiveSetup());
   s->options_ = pipeline_options(cfg);
   const CameraBackend backend = cfg.cameras[0].backend;
@@ -142,13 +142,16 @@ Expected<std::unique_ptr<LiveSetup>> LiveSetup::create(const config::RunConfig& 
   std::array<std::unique_ptr<hal::Camera>, 2> cams;
   std::array<hal::CameraConfig, 2> native{};
   if (backend == CameraBackend::kSim) {
-    say(log, "rendering the simulated camera loop (" + std::to_string(cfg.sim.loop_frames) +
-                 " frames x 2 cameras)...");
+    say(log,
+        "rendering the simulated camera loop (" + std::to_string(cfg.sim.loop_frames) +
+            " frames x 2 cameras)...",
+        command);
     auto loop = hal::SimFrameLoop::render(config::sim_options(cfg));
     if (!loop) return loop.error();
     s->loop_ = std::move(loop).value();
     say(log,
-        "simulated loop ready (" + std::to_string(s->loop_->memory_bytes() / 1'000'000) + " MB)");
+        "simulated loop ready (" + std::to_string(s->loop_->memory_bytes() / 1'000'000) + " MB)",
+        command);
     s->trigger_ = std::make_shared<hal::SimTrigger>(s->loop_);
     const sim::SimScene& scene = s->loop_->scene();
     assets = config::load_tracking_assets(cfg, &scene.rig, &scene.targets, &scene.joints_true);
@@ -205,8 +208,10 @@ Expected<std::unique_ptr<LiveSetup>> LiveSetup::create(const config::RunConfig& 
         camera_config(cfg.cameras[c], native[c], assets->rig.cameras[c], depth);
     if (auto r = cams[c]->configure(want); !r) return r.error();
     if (c == 0 && cfg.faults.stall_after_frames > 0) {
-      say(log, "fault injection: camera 0 stalls after " +
-                   std::to_string(cfg.faults.stall_after_frames) + " frames");
+      say(log,
+          "fault injection: camera 0 stalls after " +
+              std::to_string(cfg.faults.stall_after_frames) + " frames",
+          command);
       cams[c] = std::make_unique<StallingCamera>(std::move(cams[c]), cfg.faults.stall_after_frames);
     }
   }
@@ -214,10 +219,11 @@ Expected<std::unique_ptr<LiveSetup>> LiveSetup::create(const config::RunConfig& 
 
   const JointModel* model = assets->model ? &*assets->model : nullptr;
   if (model == nullptr)
-    say(log, "note: no joint model: poses are tracked, no joint angles are sent");
+    say(log, "note: no joint model: poses are tracked, no joint angles are sent", command);
   auto proc = FrameProcessor::create(assets->rig, assets->targets, model, cfg.tracker);
   if (!proc) return proc.error();
   s->processor_.emplace(std::move(proc).value());
+  s->assets_ = std::move(assets).value();
   return s;
 }
 

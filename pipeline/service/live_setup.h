@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "config/run_config.h"
+#include "config/tracking_assets.h"
 #include "core/expected.h"
 #include "formats/recording.h"
 #include "hal/camera.h"
@@ -58,13 +59,18 @@ pipeline::PipelineOptions pipeline_options(const config::RunConfig& cfg);
 class LiveSetup {
  public:
   // Renders the sim loop / opens the recording / opens the devices, configures the
-  // cameras and builds the tracker. Progress lines go to `log` (may be null).
-  static Expected<std::unique_ptr<LiveSetup>> create(const config::RunConfig& cfg, std::FILE* log);
+  // cameras and builds the tracker. Progress lines go to `log` (may be null), prefixed
+  // with `command` ("mocap run", "mocap record").
+  static Expected<std::unique_ptr<LiveSetup>> create(const config::RunConfig& cfg, std::FILE* log,
+                                                     const char* command = "mocap run");
 
   std::array<hal::Camera*, 2> cameras() const noexcept { return {cams_[0].get(), cams_[1].get()}; }
   // The tracker, to be moved into the pipeline (once).
   FrameProcessor take_processor() { return std::move(*processor_); }
   const pipeline::PipelineOptions& options() const noexcept { return options_; }
+  // The rig, targets and joint model the tracker was built with (`mocap record` writes
+  // them into its recording).
+  const config::TrackingAssets& assets() const noexcept { return assets_; }
   // One line per camera fallback (hal::Camera::notice), empty entries left out.
   std::vector<std::string> notices() const;
 
@@ -75,6 +81,7 @@ class LiveSetup {
   std::shared_ptr<const Recording> recording_;
   std::array<std::unique_ptr<hal::Camera>, 2> cams_;
   std::optional<FrameProcessor> processor_;
+  config::TrackingAssets assets_;
   pipeline::PipelineOptions options_;
 };
 

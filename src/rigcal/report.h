@@ -7,7 +7,7 @@
 #include <string>
 
 #include "core/expected.h"
-#include "rigcal/png_writer.h"
+#include "formats/png_writer.h"
 #include "rigcal/rig_calibrator.h"
 
 namespace mocap::rigcal {

@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 #include <zlib.h>
 
-#include "rigcal/png_writer.h"
+#include "formats/png_writer.h"
 #include "rigcal/report.h"
 #include "tests/support/test_support.h"
 

@@ -1,12 +1,12 @@
 // Design: see png_writer.h.
-#include "rigcal/png_writer.h"
+#include "formats/png_writer.h"
 
 #include <zlib.h>
 
 #include <cstdio>
 #include <cstring>
 
-namespace mocap::rigcal {
+namespace mocap {
 namespace {
 
 void put_u32(std::vector<std::uint8_t>& out, std::uint32_t v) {
@@ -64,4 +64,4 @@ Expected<void> write_png(const std::string& path, const RgbImage& image) {
   return {};
 }
 
-}  // namespace mocap::rigcal
+}  // namespace mocap

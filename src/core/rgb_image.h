@@ -1,15 +1,13 @@
-// Design: a minimal PNG encoder (8-bit RGB, no interlace, filter 0 on every row) for
-// the calibration report's coverage images: the IHDR/IDAT/IEND chunks with zlib's
-// compress() for the image data and crc32() for the chunk checksums.
+// Design: an owned 8-bit RGB raster for diagnostic pictures (the calibration report's
+// coverage maps, the blob overlays of `mocap preview`), written as PNG by
+// formats/png_writer.h. Setup/offline code: it allocates; set() clips to the image.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
-#include <string>
 #include <vector>
 
-#include "core/expected.h"
-
-namespace mocap::rigcal {
+namespace mocap {
 
 struct RgbImage {
   int width = 0, height = 0;
@@ -26,8 +24,4 @@ struct RgbImage {
   }
 };
 
-// The PNG file's bytes.
-Expected<std::vector<std::uint8_t>> encode_png(const RgbImage& image);
-Expected<void> write_png(const std::string& path, const RgbImage& image);
-
-}  // namespace mocap::rigcal
+}  // namespace mocap

@@ -1,0 +1,234 @@
+// Design: see frame_recorder.h.
+#include "pipeline/record/frame_recorder.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstring>
+
+namespace mocap::record {
+
+Expected<std::unique_ptr<FrameRecorder>> FrameRecorder::create(const RecorderOptions& o) {
+  if (o.slots_per_camera < 2 || !rt::is_power_of_two(o.slots_per_camera) ||
+      o.slots_per_camera > 4096) {
+    return make_error(
+        "mocap record", "--buffer-frames",
+        "must be a power of two in 2..4096, got " + std::to_string(o.slots_per_camera));
+  }
+  std::size_t max_bytes = 0;
+  for (const CameraGeometry& g : o.cameras) {
+    if (g.width <= 0 || g.height <= 0)
+      return make_error("mocap record", "camera size", "unknown (width or height 0)");
+    max_bytes =
+        std::max(max_bytes, static_cast<std::size_t>(g.width) * static_cast<std::size_t>(g.height) *
+                                static_cast<std::size_t>(bytes_per_pixel(g.format)));
+  }
+  auto files =
+      RecordingFiles::open(o.dir, {o.camera_names[0], o.camera_names[1]}, max_bytes, o.byte_budget);
+  if (!files) return files.error();
+  std::unique_ptr<FrameRecorder> r(new FrameRecorder(o, std::move(files).value()));
+  hal::PairerConfig pc;
+  pc.tolerance = o.pair_by == pipeline::PairBy::kSequence ? 0 : o.pair_tolerance_ns;
+  pc.max_pending = o.slots_per_camera;
+  auto pairer = hal::FramePairer::create(pc);
+  if (!pairer) return pairer.error();
+  r->pairer_.emplace(std::move(pairer).value());
+  for (std::size_t c = 0; c < 2; ++c) {
+    const CameraGeometry& g = o.cameras[c];
+    const std::size_t bytes = static_cast<std::size_t>(g.width) *
+                              static_cast<std::size_t>(g.height) *
+                              static_cast<std::size_t>(bytes_per_pixel(g.format));
+    r->slots_[c].resize(o.slots_per_camera);
+    for (Slot& s : r->slots_[c]) s.pixels.assign(bytes, 0);  // touched: no page faults later
+    auto filled = rt::SpscRing<std::uint32_t>::create(o.slots_per_camera);
+    auto free = rt::SpscRing<std::uint32_t>::create(o.slots_per_camera);
+    if (!filled) return filled.error();
+    if (!free) return free.error();
+    r->filled_[c] = std::make_unique<rt::SpscRing<std::uint32_t>>(std::move(filled).value());
+    r->free_[c] = std::make_unique<rt::SpscRing<std::uint32_t>>(std::move(free).value());
+    for (std::uint32_t i = 0; i < o.slots_per_camera; ++i) (void)r->free_[c]->try_push(i);
+  }
+  r->units_.reserve(4 * static_cast<std::size_t>(o.slots_per_camera));
+  return r;
+}
+
+FrameRecorder::FrameRecorder(const RecorderOptions& options, RecordingFiles files)
+    : options_(options), files_(std::move(files)) {}
+
+FrameRecorder::~FrameRecorder() {
+  if (writer_.joinable()) {
+    stop_.store(true, std::memory_order_release);
+    writer_.join();
+  }
+}
+
+void FrameRecorder::start() {
+  if (!writer_.joinable()) writer_ = std::thread([this] { writer_loop(); });
+}
+
+void FrameRecorder::on_frame(int camera, const hal::Frame& frame) noexcept {
+  const auto c = static_cast<std::size_t>(camera & 1);
+  if (!have_base_) {
+    have_base_ = true;
+    base_sequence_ = frame.sequence;
+  }
+  if (frame.sequence < base_sequence_) {  // older than the first frame: cannot be numbered
+    dropped_[c].add();
+    return;
+  }
+  const std::uint64_t number = frame.sequence - base_sequence_;
+  if (options_.max_frames != 0 && number >= options_.max_frames) return;
+  // relaxed: a progress figure; a single writer (this thread).
+  if (number + 1 > seen_.load(std::memory_order_relaxed))
+    seen_.store(number + 1, std::memory_order_relaxed);
+  std::uint32_t index = 0;
+  bool got = free_[c]->try_pop(index);
+  if (!got && options_.wait_for_slot_ms > 0) {  // lockstep only: wait for the writer
+    const std::int64_t deadline =
+        hal::monotonic_ns() + static_cast<std::int64_t>(options_.wait_for_slot_ms) * 1'000'000;
+    while (!got && !failed() && hal::monotonic_ns() < deadline) {
+      hal::sleep_until_ns(hal::monotonic_ns() + 500'000);
+      got = free_[c]->try_pop(index);
+    }
+  }
+  if (!got) {  // the writer is behind: drop this image, counted
+    dropped_[c].add();
+    return;
+  }
+  Slot& s = slots_[c][index];
+  s.sequence = frame.sequence;
+  s.frame = static_cast<std::int64_t>(number);
+  s.timestamp_ns = frame.timestamp_ns;
+  s.missing = frame.missing || frame.image.empty();
+  s.view = ImageView{};
+  if (!s.missing) {
+    const ImageView& in = frame.image;
+    const auto row_bytes =
+        static_cast<std::size_t>(in.width) * static_cast<std::size_t>(bytes_per_pixel(in.format));
+    if (row_bytes * static_cast<std::size_t>(in.height) > s.pixels.size()) {
+      dropped_[c].add();  // larger than configured: cannot happen with a sane backend
+      (void)free_[c]->try_push(index);
+      return;
+    }
+    for (int y = 0; y < in.height; ++y)
+      std::memcpy(s.pixels.data() + static_cast<std::size_t>(y) * row_bytes, in.row8(y), row_bytes);
+    s.view = ImageView{s.pixels.data(), in.width, in.height, static_cast<int>(row_bytes),
+                       in.format,       in.maxval};
+  }
+  (void)filled_[c]->try_push(index);  // never full: it has a place for every slot
+}
+
+void FrameRecorder::free_slot(int camera, std::int32_t slot) noexcept {
+  if (slot >= 0)
+    (void)free_[static_cast<std::size_t>(camera)]->try_push(static_cast<std::uint32_t>(slot));
+}
+
+bool FrameRecorder::drain(bool flush) {
+  bool got = false;
+  auto on_drop = [this](int camera, const hal::PairEntry& e) {
+    Unit u;
+    u.frame = slots_[static_cast<std::size_t>(camera)][e.handle].frame;
+    u.slot[camera] = static_cast<std::int32_t>(e.handle);
+    units_.push_back(u);
+  };
+  for (int c = 0; c < 2; ++c) {
+    std::uint32_t index = 0;
+    while (filled_[static_cast<std::size_t>(c)]->try_pop(index)) {
+      got = true;
+      const Slot& s = slots_[static_cast<std::size_t>(c)][index];
+      const std::int64_t key = options_.pair_by == pipeline::PairBy::kSequence
+                                   ? static_cast<std::int64_t>(s.sequence)
+                                   : s.timestamp_ns;
+      hal::FramePair pair;
+      if (pairer_->push(c, hal::PairEntry{key, index}, pair, on_drop)) {
+        Unit u;
+        u.slot[0] = static_cast<std::int32_t>(pair.cam[0].handle);
+        u.slot[1] = static_cast<std::int32_t>(pair.cam[1].handle);
+        u.frame = slots_[0][pair.cam[0].handle].frame;
+        units_.push_back(u);
+      }
+    }
+  }
+  if (flush) pairer_->flush(on_drop);  // the frames whose partner never came
+  return got;
+}
+
+void FrameRecorder::write_unit(const Unit& u) {
+  const bool skip = error_.has_value() || u.frame <= last_frame_;
+  if (!skip) {
+    // Recordings number their frames from 0: the first frame written is frame 0 (the
+    // same as the tap's numbering unless every image of the first frames was dropped).
+    if (first_frame_ < 0) first_frame_ = u.frame;
+    const std::int64_t number = u.frame - first_frame_;
+    int written[2] = {-1, -1};
+    Expected<void> r;
+    for (int c = 0; c < 2 && r; ++c) {
+      if (u.slot[c] < 0) continue;
+      const Slot& s = slots_[static_cast<std::size_t>(c)][static_cast<std::size_t>(u.slot[c])];
+      if (s.missing) continue;
+      r = files_.write_image(c, number, s.view);
+      if (r) written[c] = c;
+    }
+    const int ts_cam = u.slot[0] >= 0 ? 0 : 1;
+    const Slot& ts =
+        slots_[static_cast<std::size_t>(ts_cam)][static_cast<std::size_t>(u.slot[ts_cam])];
+    if (r) r = files_.append_row(number, ts.timestamp_ns);
+    if (!r) {  // the frame is not in frames.csv: its files go too
+      for (int c : written)
+        if (c >= 0) files_.remove_image(c, number);
+      error_ = r.error();
+      failed_.store(true, std::memory_order_release);  // pairs with failed()'s acquire
+      not_written_.add();
+    } else {
+      last_frame_ = u.frame;
+      frames_written_.add();
+      for (int c : written)
+        if (c >= 0) images_written_.add();
+      bytes_written_.add(files_.bytes_written() - bytes_written_.get());
+    }
+  } else {
+    not_written_.add();
+  }
+  free_slot(0, u.slot[0]);
+  free_slot(1, u.slot[1]);
+}
+
+void FrameRecorder::writer_loop() {
+  for (;;) {
+    // acquire: pairs with finish()'s release after the capture thread was joined, so the
+    // drain below sees every frame the tap pushed.
+    const bool stopping = stop_.load(std::memory_order_acquire);
+    const bool got = drain(stopping);
+    std::sort(units_.begin(), units_.end(),
+              [](const Unit& a, const Unit& b) { return a.frame < b.frame; });
+    for (const Unit& u : units_) write_unit(u);
+    units_.clear();
+    if (stopping) break;
+    if (!got) std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+}
+
+Expected<void> FrameRecorder::finish() {
+  if (writer_.joinable()) {
+    stop_.store(true, std::memory_order_release);
+    writer_.join();
+  } else {
+    drain(true);
+    for (const Unit& u : units_) write_unit(u);
+    units_.clear();
+  }
+  auto synced = files_.finish();
+  if (error_) return *error_;
+  return synced;
+}
+
+RecorderCounts FrameRecorder::counts() const noexcept {
+  RecorderCounts k;
+  k.frames_written = frames_written_.get();
+  k.images_written = images_written_.get();
+  k.bytes_written = bytes_written_.get();
+  k.dropped = {dropped_[0].get(), dropped_[1].get()};
+  k.not_written = not_written_.get();
+  return k;
+}
+
+}  // namespace mocap::record

@@ -1,0 +1,129 @@
+// Design: `mocap record`'s tap on the live pipeline (pipeline::FrameTap) and its writer.
+//
+//   capture thread --on_frame--> [slot pool per camera: images copied into preallocated
+//   (hot path)                    slots; indices through two SPSC rings: filled / free]
+//                                        |
+//                     writer thread <----+  pairs the frames with hal::FramePairer (the
+//                     (not real-time)       pipeline's pairing: by trigger sequence or by
+//                                           timestamp), writes each frame's PGMs, then its
+//                                           frames.csv row (RecordingFiles), frees slots
+//
+// on_frame (capture thread) is noexcept and allocation-free: it takes a free slot, copies
+// the image (a memcpy of one frame) and pushes the slot index; with no free slot the frame
+// is dropped and counted (drops[camera]) -- capture never blocks. Only in lockstep pacing
+// (wait_for_slot_ms > 0) it waits for a slot, as the lockstep trigger waits for the
+// pipeline, so that a replay is recorded image for image.
+// Frame numbers: the frame's sequence number minus that of the first frame written (so a
+// replay keeps its source's numbers; a trigger the pipeline skipped is a gap). A frame
+// is one row of frames.csv with the timestamp of camera 0's image (camera 1's when camera
+// 0 has none); a camera without an image for it (dropped, missing in a replay) has no
+// file. After the first write error the writer writes nothing more (the error is kept and
+// failed() turns true); what was written stays a valid recording (RecordingFiles).
+#pragma once
+
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "core/expected.h"
+#include "hal/frame_pairer.h"
+#include "hal/rt/counter.h"
+#include "hal/rt/spsc_ring.h"
+#include "pipeline/pipeline.h"
+#include "pipeline/record/recording_files.h"
+
+namespace mocap::record {
+
+struct CameraGeometry {
+  int width = 0, height = 0;
+  PixelFormat format = PixelFormat::kMono8;
+};
+
+struct RecorderOptions {
+  std::string dir;  // exists, holds no frames.csv yet
+  std::array<std::string, 2> camera_names;
+  std::array<CameraGeometry, 2> cameras;  // the configured image sizes (slot sizes)
+  std::uint32_t slots_per_camera = 64;    // power of two >= 2: the write-behind buffer
+  std::uint64_t max_frames = 0;           // frames numbered >= this are ignored (0: all)
+  int wait_for_slot_ms = 0;               // > 0 only in lockstep pacing
+  pipeline::PairBy pair_by = pipeline::PairBy::kSequence;
+  std::int64_t pair_tolerance_ns = 1'000'000;
+  std::uint64_t byte_budget = 0;  // test hook: ENOSPC past this many bytes (0: off)
+};
+
+struct RecorderCounts {
+  std::uint64_t frames_written = 0;  // rows of frames.csv
+  std::uint64_t images_written = 0;  // PGM files
+  std::uint64_t bytes_written = 0;
+  std::array<std::uint64_t, 2> dropped{};  // images dropped at the tap (no free slot)
+  std::uint64_t not_written = 0;           // frames queued when writing failed or out of order
+};
+
+class FrameRecorder final : public pipeline::FrameTap {
+ public:
+  // Allocates every slot and opens frames.csv (RecordingFiles::open).
+  static Expected<std::unique_ptr<FrameRecorder>> create(const RecorderOptions& options);
+  ~FrameRecorder() override;
+
+  // Starts the writer thread.
+  void start();
+  // Capture thread (hot path).
+  void on_frame(int camera, const hal::Frame& frame) noexcept override;
+  // Waits for the writer to write everything queued, stops it and syncs the folder. The
+  // first write error, if any (one line naming the file and the problem).
+  Expected<void> finish();
+
+  // Any thread.
+  RecorderCounts counts() const noexcept;
+  bool failed() const noexcept { return failed_.load(std::memory_order_acquire); }
+  // Frames (by number) the tap has seen so far, and whether every one of max_frames did.
+  std::uint64_t frames_seen() const noexcept { return seen_.load(std::memory_order_relaxed); }
+
+ private:
+  struct Slot {
+    std::vector<std::uint8_t> pixels;  // tightly packed, the camera's size
+    ImageView view;                    // into pixels (empty when missing)
+    std::uint64_t sequence = 0;
+    std::int64_t frame = 0;  // sequence - the first sequence seen
+    std::int64_t timestamp_ns = 0;
+    bool missing = false;
+  };
+  struct Unit {  // one frame to write: slot index per camera, -1 if none
+    std::int64_t frame = 0;
+    std::int32_t slot[2] = {-1, -1};
+  };
+
+  explicit FrameRecorder(const RecorderOptions& options, RecordingFiles files);
+  void writer_loop();
+  // Pops the filled rings into the pairer; appends the completed frames to units_.
+  bool drain(bool flush);
+  void write_unit(const Unit& u);
+  void free_slot(int camera, std::int32_t slot) noexcept;
+
+  RecorderOptions options_;
+  RecordingFiles files_;
+  std::array<std::vector<Slot>, 2> slots_;
+  std::array<std::unique_ptr<rt::SpscRing<std::uint32_t>>, 2> filled_, free_;
+  std::optional<hal::FramePairer> pairer_;  // writer thread
+  std::vector<Unit> units_;                 // writer thread, reserved
+  std::int64_t last_frame_ = -1;            // writer thread: tap numbering
+  std::int64_t first_frame_ = -1;           // writer thread: the tap's number of frame 0
+  std::optional<Error> error_;              // writer thread until joined
+
+  // Capture thread.
+  bool have_base_ = false;
+  std::uint64_t base_sequence_ = 0;
+
+  rt::Counter dropped_[2], frames_written_, images_written_, bytes_written_, not_written_;
+  std::atomic<std::uint64_t> seen_{0};
+  std::atomic<bool> failed_{false};
+  std::atomic<bool> stop_{false};
+  std::thread writer_;
+};
+
+}  // namespace mocap::record

@@ -1,0 +1,243 @@
+// `mocap record [--config FILE] --out DIR [--duration SECONDS | --frames N]`: records the
+// cameras of the run configuration (without --config: the built-in simulated cameras, as
+// `mocap run`) into a recording folder (the spec's "Recording", docs/formats.md). The
+// cameras, trigger and pairing are `mocap run`'s own: service::LiveSetup opens them and
+// the live pipeline::Pipeline drives them (detection and tracking run as in `mocap run`,
+// nothing is published); a pipeline::FrameTap (record::FrameRecorder) copies every
+// delivered image into preallocated slots and a writer thread writes the files
+// (pipeline/record). Stops after --duration / --frames, at the end of a replayed source,
+// on SIGINT/SIGTERM, or at the first write error (full disk, unwritable folder): what was
+// written is always a valid recording. A progress line every --progress-interval seconds;
+// drops are reported at the end. Exit codes: 0 recorded (also when stopped by a signal),
+// 1 writing failed (the recording holds the frames before the failure), 2 bad input.
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <thread>
+
+#include "app/command_registry.h"
+#include "formats/recording.h"
+#include "pipeline/pipeline.h"
+#include "pipeline/record/frame_recorder.h"
+#include "pipeline/record/recording_assets.h"
+#include "pipeline/service/live_setup.h"
+
+namespace mocap::app {
+namespace {
+
+std::atomic<int> g_record_signal{0};
+static_assert(std::atomic<int>::is_always_lock_free, "used from a signal handler");
+
+extern "C" void on_record_signal(int sig) {
+  // relaxed: a lock-free atomic store is async-signal-safe; the main loop polls it.
+  g_record_signal.store(sig, std::memory_order_relaxed);
+}
+
+constexpr int kExitWriteFailed = 1;
+
+struct RecordArgs {
+  std::string config;
+  std::string out;
+  double duration_s = 0.0;
+  long long frames = 0;
+  double rate_hz = 100.0;
+  int loop_frames = 200;
+  int buffer_frames = 64;
+  double progress_interval_s = 1.0;
+  bool no_realtime = false;
+  bool duration_given = false, frames_given = false, rate_given = false, loop_given = false;
+};
+
+Expected<void> check_args(const RecordArgs& a) {
+  if (a.out.empty())
+    return make_error("mocap record", "--out", "is required (the recording folder)");
+  if (a.duration_given && a.frames_given)
+    return make_error("mocap record", "--duration/--frames", "give one of them, not both");
+  if (a.duration_given && !(a.duration_s > 0.0))
+    return make_error("mocap record", "--duration", "must be > 0 seconds");
+  if (a.frames_given && a.frames < 1)
+    return make_error("mocap record", "--frames", "must be >= 1, got " + std::to_string(a.frames));
+  if (!(a.progress_interval_s >= 0.0))
+    return make_error("mocap record", "--progress-interval", "must be >= 0");
+  return {};
+}
+
+// Data rate of the cameras as configured, MB/s (for the drop warning).
+double camera_rate_mb_s(const record::RecorderOptions& o, double rate_hz) {
+  double bytes = 0.0;
+  for (const record::CameraGeometry& g : o.cameras)
+    bytes += static_cast<double>(g.width) * g.height * bytes_per_pixel(g.format);
+  return bytes * rate_hz / 1e6;
+}
+
+int record(const RecordArgs& a) {
+  if (auto r = check_args(a); !r) return fail(r.error().message);
+  service::CliOverrides cli;
+  if (a.rate_given) cli.rate_hz = a.rate_hz;
+  if (a.loop_given) cli.loop_frames = a.loop_frames;
+  cli.no_realtime = a.no_realtime;
+  cli.no_iceoryx = true;
+  auto cfg = service::resolve_run_config(a.config, cli);
+  if (!cfg) return fail(cfg.error().message);
+  if (auto r = record::prepare_output_dir(a.out); !r) return fail(r.error().message);
+  std::signal(SIGINT, on_record_signal);
+  std::signal(SIGTERM, on_record_signal);
+  auto live = service::LiveSetup::create(*cfg, stderr, "mocap record");
+  if (!live) return fail(live.error().message);
+  for (const std::string& n : (*live)->notices())
+    std::fprintf(stderr, "mocap record: note: %s\n", n.c_str());
+  auto assets = record::write_recording_assets(a.out, *cfg, (*live)->assets());
+  if (!assets) return fail(assets.error().message);
+
+  pipeline::PipelineOptions opt = (*live)->options();
+  const bool lockstep = opt.pacing == pipeline::TriggerPacing::kLockstep;
+  record::RecorderOptions ro;
+  ro.dir = a.out;
+  for (std::size_t c = 0; c < 2; ++c) {
+    const hal::CameraConfig& cc = (*live)->cameras()[c]->config();
+    ro.camera_names[c] = (*live)->assets().rig.cameras[c].name;
+    ro.cameras[c] = record::CameraGeometry{cc.width, cc.height, cc.format};
+  }
+  ro.slots_per_camera = static_cast<std::uint32_t>(a.buffer_frames);
+  // A replay ends with its source: the pipeline triggers its frames (lockstep: one frame
+  // per trigger) and the recorder takes the source's frame numbers.
+  std::uint64_t trigger_limit = a.frames_given ? static_cast<std::uint64_t>(a.frames) : 0;
+  std::uint64_t frame_limit = trigger_limit;
+  if (!a.frames_given && cfg->cameras[0].backend == config::CameraBackend::kReplay) {
+    auto source = Recording::open(cfg->cameras[0].device);
+    if (!source) return fail(source.error().message);
+    trigger_limit = source->frames().size();
+    frame_limit = static_cast<std::uint64_t>(source->frames().back().frame) + 1;
+  }
+  ro.max_frames = frame_limit;
+  ro.wait_for_slot_ms = lockstep ? 1000 : 0;  // lockstep records every frame
+  ro.pair_by = opt.pair_by;
+  ro.pair_tolerance_ns = opt.pair_tolerance_us * 1000;
+  auto recorder = record::FrameRecorder::create(ro);
+  if (!recorder) return fail(recorder.error().message);
+  opt.tap = recorder->get();
+  opt.max_frames = trigger_limit;
+  auto pipe = pipeline::Pipeline::create((*live)->take_processor(), (*live)->cameras(), {}, opt);
+  if (!pipe) return fail(pipe.error().message);
+  (*recorder)->start();
+  if (g_record_signal.load(std::memory_order_relaxed) == 0) {
+    if (auto r = (*pipe)->start(); !r) {
+      (void)(*recorder)->finish();
+      return fail(r.error().message);
+    }
+  }
+  for (const std::string& n : (*pipe)->notes())
+    std::fprintf(stderr, "mocap record: note: %s\n", n.c_str());
+  std::fprintf(stderr, "mocap record: recording %s cameras at %.0f Hz into %s%s\n",
+               config::to_string(cfg->cameras[0].backend), opt.trigger_rate_hz, a.out.c_str(),
+               a.duration_given ? (" for " + std::to_string(a.duration_s) + " s").c_str()
+                                : " (Ctrl-C stops)");
+
+  using Clock = std::chrono::steady_clock;
+  const auto t0 = Clock::now();
+  auto since = [](Clock::time_point t) {
+    return std::chrono::duration<double>(Clock::now() - t).count();
+  };
+  auto last_report = t0;
+  record::RecorderCounts last = (*recorder)->counts();
+  Clock::time_point all_seen{};
+  bool have_all_seen = false;
+  while ((*pipe)->running() && g_record_signal.load(std::memory_order_relaxed) == 0) {
+    if ((*recorder)->failed() || (*pipe)->finished()) break;
+    if (a.duration_given && since(t0) >= a.duration_s) break;
+    if (frame_limit != 0 && (*recorder)->frames_seen() >= frame_limit) {
+      if (!have_all_seen) all_seen = Clock::now();
+      have_all_seen = true;
+      if (since(all_seen) > 0.5) break;  // free-running cameras: the last partner had time
+    }
+    if (a.progress_interval_s > 0.0 && since(last_report) >= a.progress_interval_s) {
+      const double dt = since(last_report);
+      last_report = Clock::now();
+      const record::RecorderCounts k = (*recorder)->counts();
+      std::fprintf(stderr, "mocap record: %.1f s, %llu frames, %llu dropped, %.1f MB/s\n",
+                   since(t0), static_cast<unsigned long long>(k.frames_written),
+                   static_cast<unsigned long long>(k.dropped[0] + k.dropped[1]),
+                   static_cast<double>(k.bytes_written - last.bytes_written) / 1e6 / dt);
+      last = k;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  (*pipe)->stop();
+  const double elapsed_s = since(t0);
+  auto finished = (*recorder)->finish();
+  const record::RecorderCounts k = (*recorder)->counts();
+  std::uint64_t camera_drops = 0;
+  for (hal::Camera* cam : (*live)->cameras()) camera_drops += cam->counters().dropped.get();
+  std::printf("mocap record: %llu frames (%llu images, %.1f MB) in %.1f s written to %s\n",
+              static_cast<unsigned long long>(k.frames_written),
+              static_cast<unsigned long long>(k.images_written),
+              static_cast<double>(k.bytes_written) / 1e6, elapsed_s, a.out.c_str());
+  std::printf(
+      "mocap record: dropped images: cam0 %llu, cam1 %llu (writer behind); "
+      "frames the cameras dropped: %llu\n",
+      static_cast<unsigned long long>(k.dropped[0]), static_cast<unsigned long long>(k.dropped[1]),
+      static_cast<unsigned long long>(camera_drops));
+  if (k.dropped[0] + k.dropped[1] > 0) {
+    std::fprintf(stderr,
+                 "mocap record: warning: %llu images dropped because the disk wrote %.1f MB/s, "
+                 "slower than the cameras' %.1f MB/s (their frames have missing files)\n",
+                 static_cast<unsigned long long>(k.dropped[0] + k.dropped[1]),
+                 elapsed_s > 0.0 ? static_cast<double>(k.bytes_written) / 1e6 / elapsed_s : 0.0,
+                 camera_rate_mb_s(ro, opt.trigger_rate_hz));
+  }
+  if (!finished) {
+    std::fprintf(stderr, "mocap: %s (the recording keeps the %llu frames written before)\n",
+                 finished.error().message.c_str(),
+                 static_cast<unsigned long long>(k.frames_written));
+    return kExitWriteFailed;
+  }
+  if (const int sig = g_record_signal.load(std::memory_order_relaxed); sig != 0) {
+    if (k.frames_written > 0) {
+      std::fprintf(stderr, "mocap record: stopped by %s: %s is a valid recording\n",
+                   sig == SIGINT ? "SIGINT" : "SIGTERM", a.out.c_str());
+    } else {
+      std::fprintf(stderr,
+                   "mocap record: stopped by %s before the first frame: %s holds no frame\n",
+                   sig == SIGINT ? "SIGINT" : "SIGTERM", a.out.c_str());
+    }
+  }
+  return 0;
+}
+
+void register_record(CLI::App& app, int& exit_code) {
+  auto args = std::make_shared<RecordArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "record", "Record the cameras of the run configuration into a recording folder");
+  cmd->add_option("--config", args->config,
+                  "Record the cameras of this run configuration (default: the built-in "
+                  "simulated cameras)");
+  cmd->add_option("--out", args->out, "The recording folder to write (new or empty)");
+  cmd->add_option("--duration", args->duration_s, "Stop after this many seconds");
+  cmd->add_option("--frames", args->frames, "Stop after this many frames");
+  cmd->add_option("--rate", args->rate_hz, "Trigger rate in Hz (default: the configuration's)")
+      ->check(CLI::Range(1.0, 1000.0));
+  cmd->add_option("--loop-frames", args->loop_frames,
+                  "Frames pre-rendered for the simulated cameras (default 200)")
+      ->check(CLI::Range(2, 2000));
+  cmd->add_option("--buffer-frames", args->buffer_frames,
+                  "Frames per camera the writer may fall behind before images are dropped "
+                  "(power of two, default 64)");
+  cmd->add_option("--progress-interval", args->progress_interval_s,
+                  "Seconds between progress lines on stderr (default 1; 0: off)");
+  cmd->add_flag("--no-realtime", args->no_realtime, "No CPU pinning and no SCHED_FIFO");
+  cmd->callback([cmd, args, &exit_code] {
+    args->duration_given = cmd->count("--duration") > 0;
+    args->frames_given = cmd->count("--frames") > 0;
+    args->rate_given = cmd->count("--rate") > 0;
+    args->loop_given = cmd->count("--loop-frames") > 0;
+    exit_code = record(*args);
+  });
+}
+
+const CommandRegistrar kRegistrar(65, register_record);
+
+}  // namespace
+}  // namespace mocap::app
