@@ -248,6 +248,58 @@ bool seed(Builder& b, const std::vector<int>& group) {
   return true;
 }
 
+// The same body built twice from clusters of different time windows (occlusions cut
+// every track between them): B is A when A's target, identified among B's tracks (and
+// B's among A's), keeps one constant pose relative to B (rotation within 1 deg,
+// translation within 2 mm) over at least min_covisible_frames frames in which A turned
+// by min_pair_rotation_deg. B's markers then join A's (or are left to the pool).
+bool merge_if_same(Builder& A, const Builder& B, std::vector<int>& released) {
+  Builder a = A, b = B;
+  a.extend_poses(B.members);
+  b.extend_poses(A.members);
+  std::vector<int> fs;
+  for (std::size_t f = 0; f < a.frames(); ++f)
+    if (a.body.found[f] && b.body.found[f]) fs.push_back(static_cast<int>(f));
+  if (static_cast<int>(fs.size()) < A.opt.min_covisible_frames) return false;
+  if (a.rotation_range_deg(fs) < A.opt.min_pair_rotation_deg) return false;
+  std::vector<Iso3> rel;
+  for (int f : fs)
+    rel.push_back(a.body.T_world_body[static_cast<std::size_t>(f)].inverse() * b.body.T_world_body[static_cast<std::size_t>(f)]);
+  const Iso3 T_ab = rel[rel.size() / 2];
+  for (const Iso3& T : rel) {
+    if (Eigen::AngleAxisd(T.linear() * T_ab.linear().transpose()).angle() * kRadToDeg > 1.0) return false;
+    if ((T.translation() - T_ab.translation()).norm() > 2.0) return false;
+  }
+  for (std::size_t m = 0; m < B.body.markers_body.size(); ++m) {
+    const Vec3 X_a = T_ab * B.body.markers_body[m];
+    int nearest = -1;
+    double d_min = 1e300;
+    for (std::size_t k = 0; k < A.body.markers_body.size(); ++k) {
+      const double d = (A.body.markers_body[k] - X_a).norm();
+      if (d < d_min) {
+        d_min = d;
+        nearest = static_cast<int>(k);
+      }
+    }
+    const auto& tracks_m = B.body.marker_tracks[m];
+    bool coexists = false;
+    if (nearest >= 0)
+      for (int ti : tracks_m) coexists = coexists || A.overlaps_marker(ti, nearest);
+    int target = -1;
+    if (d_min <= 0.25 * A.opt.marker_diameter_mm && !coexists) target = nearest;
+    else if (d_min >= A.opt.marker_diameter_mm) target = static_cast<int>(A.body.markers_body.size());
+    for (int ti : tracks_m) {
+      if (target < 0) {
+        released.push_back(ti);
+        continue;
+      }
+      A.place(ti, target, X_a);
+    }
+  }
+  A.compute_poses();
+  return true;
+}
+
 }  // namespace
 
 BodyBuild build_bodies(const std::vector<PointTrack>& tracks, const std::vector<std::vector<int>>& groups,
@@ -296,6 +348,19 @@ BodyBuild build_bodies(const std::vector<PointTrack>& tracks, const std::vector<
     if (b.body.markers_body.size() < 3) continue;
     for (int ti : b.members) placed[static_cast<std::size_t>(ti)] = 1;
     builders.push_back(std::move(b));
+  }
+  // Merge duplicates of one body (largest first), then refine.
+  std::vector<int> released;
+  std::vector<char> merged(builders.size(), 0);
+  for (std::size_t i = 0; i < builders.size(); ++i)
+    for (std::size_t j = i + 1; j < builders.size(); ++j)
+      if (!merged[i] && !merged[j] && merge_if_same(builders[i], builders[j], released)) merged[j] = 1;
+  for (int ti : released) placed[static_cast<std::size_t>(ti)] = 0;
+  {
+    std::vector<Builder> kept;
+    for (std::size_t i = 0; i < builders.size(); ++i)
+      if (!merged[i]) kept.push_back(std::move(builders[i]));
+    builders.swap(kept);
   }
   for (Builder& b : builders) b.refine();
   // Every long track left over goes to the one body it fits, if exactly one.

@@ -60,7 +60,7 @@ struct DiscoverOptions {
   double min_scene_speed_mm_per_s = 20.0;  // a point moving faster makes the scene "moving"
   int max_pair_frames = 400;               // pair statistics on at most this many frames
   // Joints (Eq. 2 / rank-5 hinge tests as in src/kinematics).
-  kinematics::LinearOptions linear{30, 2.0, 0.25};
+  kinematics::LinearOptions linear{20, 2.0, 0.25};
   double max_joint_residual_mm = 3.0;      // linear fit residual above this: not a joint
   int min_frames = 30;                     // fewer frames in the recording: error
   bool refine = true;                      // Ceres refinement of the joints

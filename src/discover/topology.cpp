@@ -37,7 +37,10 @@ bool score_pair(const DiscoveredBody& A, const DiscoveredBody& B, int a, int b,
   }
   edge.parent = a;
   edge.child = b;
-  if (hinge && s6 / s5 <= opt.linear.max_hinge_off_axis_ratio) {
+  // Hinge when the rank-5 test says so AND the hinge explains the motion as well as a
+  // ball (a ball joint turned little about its third axis passes the ratio test alone).
+  if (hinge && s6 / s5 <= opt.linear.max_hinge_off_axis_ratio &&
+      hinge->diagnostics.residual_rms_mm <= 2.0 * d.residual_rms_mm + 0.1) {
     edge.type = JointType::kHinge;
     edge.diagnostics = hinge->diagnostics;
   } else if (s6 >= opt.linear.min_motion_deg) {
