@@ -28,7 +28,7 @@
 namespace mocap::discover {
 
 struct DiscoveredBody {
-  std::vector<Vec3> markers_body;              // mm, body frame
+  std::vector<Vec3> markers_body;               // mm, body frame
   std::vector<std::vector<int>> marker_tracks;  // per marker: indices into the tracks
   std::vector<char> found;                      // per frame
   std::vector<Iso3> T_world_body;               // per frame (valid where found)

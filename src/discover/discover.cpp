@@ -34,16 +34,17 @@ void warn_unplaced(const std::vector<PointTrack>& tracks, const std::vector<int>
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
     return tracks[static_cast<std::size_t>(a)].seen > tracks[static_cast<std::size_t>(b)].seen;
   });
-  warnings.push_back(std::to_string(unplaced.size()) +
-                     " point track(s) seen long enough could not be placed in a body (too rarely seen "
-                     "with moving markers, or fitting two bodies); they are left out");
+  warnings.push_back(
+      std::to_string(unplaced.size()) +
+      " point track(s) seen long enough could not be placed in a body (too rarely seen "
+      "with moving markers, or fitting two bodies); they are left out");
   for (std::size_t i = 0; i < std::min<std::size_t>(order.size(), 5); ++i) {
     const PointTrack& t = tracks[static_cast<std::size_t>(order[i])];
     const Vec3& X = t.at(t.first);
     warnings.push_back("unplaced point: seen in " + std::to_string(t.seen) + " frames (" +
                        std::to_string(frames[static_cast<std::size_t>(t.first)].frame) + ".." +
-                       std::to_string(frames[static_cast<std::size_t>(t.last())].frame) + ") near world " +
-                       format_mm(X));
+                       std::to_string(frames[static_cast<std::size_t>(t.last())].frame) +
+                       ") near world " + format_mm(X));
   }
 }
 
@@ -83,8 +84,9 @@ Expected<DiscoverResult> discover_model(const PointSequence& seq, const Discover
   const std::vector<char> moving = scene_motion(seq, tracks, opt);
   st.seconds_tracking = seconds_since(t0);
   if (std::none_of(moving.begin(), moving.end(), [](char m) { return m != 0; }))
-    return Error{label + ": nothing moves (a static scene): record the robot moving its joints, so that "
-                         "markers can be grouped into bodies and joints estimated"};
+    return Error{label +
+                 ": nothing moves (a static scene): record the robot moving its joints, so that "
+                 "markers can be grouped into bodies and joints estimated"};
 
   const auto groups = group_rigid_tracks(tracks, moving, opt);
   st.clusters = static_cast<int>(groups.size());
@@ -94,12 +96,14 @@ Expected<DiscoverResult> discover_model(const PointSequence& seq, const Discover
   st.unplaced_tracks = static_cast<int>(built.unplaced_tracks.size());
   st.seconds_bodies = seconds_since(t0);
   if (built.bodies.empty())
-    return Error{label + ": no rigid body of at least 3 markers found (" + std::to_string(st.long_tracks) +
+    return Error{label + ": no rigid body of at least 3 markers found (" +
+                 std::to_string(st.long_tracks) +
                  " point tracks of >= " + std::to_string(opt.min_track_frames) +
                  " frames): the markers must be seen while the bodies turn"};
   if (built.bodies.size() == 1)
-    return Error{label + ": one rigid body only (" + std::to_string(built.bodies[0].markers_body.size()) +
-                 " markers): no joint to discover; move the robot's joints, not the robot as a whole"};
+    return Error{
+        label + ": one rigid body only (" + std::to_string(built.bodies[0].markers_body.size()) +
+        " markers): no joint to discover; move the robot's joints, not the robot as a whole"};
 
   const TopologyResult topo = infer_topology(built.bodies, opt);
   st.seconds_topology = seconds_since(t0);
@@ -123,7 +127,8 @@ Expected<DiscoverResult> discover_model(const PointSequence& seq, const Discover
     j.child = r.targets.bodies[static_cast<std::size_t>(j.child_index)].name;
     j.name = j.parent + "_" + j.child;
     j.type = e.type;
-    joined[static_cast<std::size_t>(j.parent_index)] = joined[static_cast<std::size_t>(j.child_index)] = 1;
+    joined[static_cast<std::size_t>(j.parent_index)] =
+        joined[static_cast<std::size_t>(j.child_index)] = 1;
     r.topology.joints.push_back(j);
   }
   r.input = make_calibration_input(ordered, tracks, seq.frames.size(), opt);
@@ -134,13 +139,18 @@ Expected<DiscoverResult> discover_model(const PointSequence& seq, const Discover
     if (joined[b]) continue;
     std::string why;
     for (const auto& [x, y] : topo.low_motion_pairs) {
-      const int other = new_index[static_cast<std::size_t>(x)] == static_cast<int>(b)   ? new_index[static_cast<std::size_t>(y)]
-                        : new_index[static_cast<std::size_t>(y)] == static_cast<int>(b) ? new_index[static_cast<std::size_t>(x)]
-                                                                                        : -1;
-      if (other >= 0) why += (why.empty() ? "" : ", ") + r.targets.bodies[static_cast<std::size_t>(other)].name;
+      const int other = new_index[static_cast<std::size_t>(x)] == static_cast<int>(b)
+                            ? new_index[static_cast<std::size_t>(y)]
+                        : new_index[static_cast<std::size_t>(y)] == static_cast<int>(b)
+                            ? new_index[static_cast<std::size_t>(x)]
+                            : -1;
+      if (other >= 0)
+        why += (why.empty() ? "" : ", ") + r.targets.bodies[static_cast<std::size_t>(other)].name;
     }
-    r.warnings.push_back(r.targets.bodies[b].name + ": joined to no other body (listed in targets.yaml only)" +
-                         (why.empty() ? std::string() : "; too little relative motion to determine a joint with " + why));
+    r.warnings.push_back(
+        r.targets.bodies[b].name + ": joined to no other body (listed in targets.yaml only)" +
+        (why.empty() ? std::string()
+                     : "; too little relative motion to determine a joint with " + why));
   }
   if (r.topology.joints.empty()) {  // the caller decides (joints.yaml needs a joint)
     st.seconds_calibration = seconds_since(t0);

@@ -31,9 +31,9 @@ struct DiscoverStats {
 };
 
 struct DiscoverResult {
-  TargetSet targets;     // body0..N-1: joined trees first (root, then breadth-first)
-  JointModel topology;   // joints.yaml (names "<parent>_<child>")
-  JointModel model;      // model.yaml (calibrated; empty when there is no joint)
+  TargetSet targets;    // body0..N-1: joined trees first (root, then breadth-first)
+  JointModel topology;  // joints.yaml (names "<parent>_<child>")
+  JointModel model;     // model.yaml (calibrated; empty when there is no joint)
   kinematics::CalibrationResult calibration;
   kinematics::CalibrationInput input;  // poses and markers per frame (targets' body order)
   std::vector<std::string> warnings;   // one line each

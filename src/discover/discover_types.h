@@ -38,20 +38,21 @@ struct PointTrack {
 
   int last() const noexcept { return first + static_cast<int>(X_world_mm.size()) - 1; }
   bool has(int f) const noexcept {
-    return f >= first && f <= last() && !std::isnan(X_world_mm[static_cast<std::size_t>(f - first)].x());
+    return f >= first && f <= last() &&
+           !std::isnan(X_world_mm[static_cast<std::size_t>(f - first)].x());
   }
   const Vec3& at(int f) const noexcept { return X_world_mm[static_cast<std::size_t>(f - first)]; }
 };
 
 struct DiscoverOptions {
   // Stated bounds.
-  double max_speed_mm_per_s = 3000.0;      // fastest marker
-  double max_accel_mm_per_s2 = 40000.0;    // fastest change of a marker's velocity (~4 g)
-  double point_noise_mm = 0.15;            // 1-sigma noise of a triangulated marker, per axis
-  double marker_diameter_mm = 12.0;        // written to targets.yaml; closest marker spacing
+  double max_speed_mm_per_s = 3000.0;    // fastest marker
+  double max_accel_mm_per_s2 = 40000.0;  // fastest change of a marker's velocity (~4 g)
+  double point_noise_mm = 0.15;          // 1-sigma noise of a triangulated marker, per axis
+  double marker_diameter_mm = 12.0;      // written to targets.yaml; closest marker spacing
   // Tracking.
-  int max_gap_frames = 1;                  // a track coasts over this many missed frames
-  double gate_sigmas = 4.0;                // noise part of every gate, in sigmas
+  int max_gap_frames = 1;    // a track coasts over this many missed frames
+  double gate_sigmas = 4.0;  // noise part of every gate, in sigmas
   // Grouping.
   int min_track_frames = 10;               // shorter tracks are ignored (ghosts, glints)
   int min_covisible_frames = 20;           // a pair test needs this many common frames
@@ -61,9 +62,9 @@ struct DiscoverOptions {
   int max_pair_frames = 400;               // pair statistics on at most this many frames
   // Joints (Eq. 2 / rank-5 hinge tests as in src/kinematics).
   kinematics::LinearOptions linear{20, 2.0, 0.25};
-  double max_joint_residual_mm = 3.0;      // linear fit residual above this: not a joint
-  int min_frames = 30;                     // fewer frames in the recording: error
-  bool refine = true;                      // Ceres refinement of the joints
+  double max_joint_residual_mm = 3.0;  // linear fit residual above this: not a joint
+  int min_frames = 30;                 // fewer frames in the recording: error
+  bool refine = true;                  // Ceres refinement of the joints
 
   // Derived tolerances (docs/discover.md).
   double pair_distance_std_mm() const noexcept { return 3.0 * std::sqrt(2.0) * point_noise_mm; }

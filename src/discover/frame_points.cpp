@@ -24,7 +24,9 @@ Expected<PointSequence> triangulate_recording(const std::string& recording_dir,
   std::array<detect::BlobList, 2> blobs;
   for (std::size_t c = 0; c < 2; ++c) {
     auto d = detect::BlobDetector::create(dcfg, rig.cameras[c].width, rig.cameras[c].height);
-    if (!d) return Error{recording_dir + ": detection (" + rig.cameras[c].name + "): " + d.error().message};
+    if (!d)
+      return Error{recording_dir + ": detection (" + rig.cameras[c].name +
+                   "): " + d.error().message};
     detectors[c].emplace(std::move(d).value());
     blobs[c] = detectors[c]->make_blob_list();
   }
@@ -54,7 +56,8 @@ Expected<PointSequence> triangulate_recording(const std::string& recording_dir,
       blobs[c].clear();
       if (!loaded) {  // a damaged frame is skipped (as in `mocap calibrate`), and reported
         if (!first_error) first_error = loaded.error();
-        if (cb.warn) cb.warn(loaded.error().message + " (frame " + std::to_string(fe.frame) + " skipped)");
+        if (cb.warn)
+          cb.warn(loaded.error().message + " (frame " + std::to_string(fe.frame) + " skipped)");
         both = false;
         continue;
       }

@@ -14,8 +14,9 @@ struct Active {
 };
 
 double seconds_between(const PointSequence& seq, int a, int b) {
-  const double dt = 1e-9 * static_cast<double>(seq.frames[static_cast<std::size_t>(b)].timestamp_ns -
-                                               seq.frames[static_cast<std::size_t>(a)].timestamp_ns);
+  const double dt =
+      1e-9 * static_cast<double>(seq.frames[static_cast<std::size_t>(b)].timestamp_ns -
+                                 seq.frames[static_cast<std::size_t>(a)].timestamp_ns);
   return dt > 0.0 ? dt : 0.01 * (b - a);  // non-increasing stamps: assume 100 fps
 }
 

@@ -48,8 +48,9 @@ std::vector<char> scene_motion(const PointSequence& seq, const std::vector<Point
     if (t.seen < opt.min_track_frames) continue;
     for (int f = t.first + 1; f <= t.last(); ++f) {
       if (!t.has(f) || !t.has(f - 1)) continue;
-      const double dt = 1e-9 * static_cast<double>(seq.frames[static_cast<std::size_t>(f)].timestamp_ns -
-                                                   seq.frames[static_cast<std::size_t>(f - 1)].timestamp_ns);
+      const double dt =
+          1e-9 * static_cast<double>(seq.frames[static_cast<std::size_t>(f)].timestamp_ns -
+                                     seq.frames[static_cast<std::size_t>(f - 1)].timestamp_ns);
       const double step = (t.at(f) - t.at(f - 1)).norm();
       // Noise alone moves a point by ~2 sigma per frame: require more than that too.
       if (dt > 0.0 && step / dt > opt.min_scene_speed_mm_per_s && step > 6.0 * opt.point_noise_mm)
@@ -59,8 +60,8 @@ std::vector<char> scene_motion(const PointSequence& seq, const std::vector<Point
   return moving;
 }
 
-PairRelation classify_pair(const PointTrack& a, const PointTrack& b, const std::vector<char>& moving,
-                           const DiscoverOptions& opt) {
+PairRelation classify_pair(const PointTrack& a, const PointTrack& b,
+                           const std::vector<char>& moving, const DiscoverOptions& opt) {
   const int lo = std::max(a.first, b.first), hi = std::min(a.last(), b.last());
   if (hi - lo + 1 < 5) return PairRelation::kUnknown;
   std::vector<int> frames;
@@ -71,7 +72,8 @@ PairRelation classify_pair(const PointTrack& a, const PointTrack& b, const std::
   if (n_all > opt.max_pair_frames) {
     std::vector<int> sub;
     for (int i = 0; i < opt.max_pair_frames; ++i)
-      sub.push_back(frames[static_cast<std::size_t>(static_cast<long>(i) * n_all / opt.max_pair_frames)]);
+      sub.push_back(
+          frames[static_cast<std::size_t>(static_cast<long>(i) * n_all / opt.max_pair_frames)]);
     frames = std::move(sub);
   }
   std::vector<double> dist;
@@ -96,10 +98,13 @@ PairRelation classify_pair(const PointTrack& a, const PointTrack& b, const std::
   max_angle_deg(dirs, dirs[0], &i1);
   const double turned = max_angle_deg(dirs, dirs[i1], nullptr);
   if (turned >= opt.min_pair_rotation_deg) return PairRelation::kRigid;
-  const int moving_frames = static_cast<int>(
-      std::count_if(frames.begin(), frames.end(), [&](int f) { return moving[static_cast<std::size_t>(f)] != 0; }));
+  const int moving_frames =
+      static_cast<int>(std::count_if(frames.begin(), frames.end(), [&](int f) {
+        return moving[static_cast<std::size_t>(f)] != 0;
+      }));
   if (2 * moving_frames >= static_cast<int>(frames.size()) &&
-      moving_frames * 2 >= opt.min_covisible_frames && spread_mm(a, frames) <= opt.static_tolerance_mm &&
+      moving_frames * 2 >= opt.min_covisible_frames &&
+      spread_mm(a, frames) <= opt.static_tolerance_mm &&
       spread_mm(b, frames) <= opt.static_tolerance_mm)
     return PairRelation::kRigid;
   return PairRelation::kUnknown;
@@ -128,7 +133,8 @@ std::vector<std::vector<int>> group_rigid_tracks(const std::vector<PointTrack>& 
         edges.push_back({i, j, std::min(ta.last(), tb.last()) - std::max(ta.first, tb.first)});
     }
   }
-  std::stable_sort(edges.begin(), edges.end(), [](const Edge& x, const Edge& y) { return x.common > y.common; });
+  std::stable_sort(edges.begin(), edges.end(),
+                   [](const Edge& x, const Edge& y) { return x.common > y.common; });
   std::vector<std::size_t> cluster(n);
   std::iota(cluster.begin(), cluster.end(), 0);
   std::vector<std::vector<std::size_t>> members(n);

@@ -28,8 +28,8 @@ enum class PairRelation : unsigned char { kUnknown, kRigid, kNonRigid };
 std::vector<char> scene_motion(const PointSequence& seq, const std::vector<PointTrack>& tracks,
                                const DiscoverOptions& options);
 
-PairRelation classify_pair(const PointTrack& a, const PointTrack& b, const std::vector<char>& moving,
-                           const DiscoverOptions& options);
+PairRelation classify_pair(const PointTrack& a, const PointTrack& b,
+                           const std::vector<char>& moving, const DiscoverOptions& options);
 
 // Clusters of indices into `tracks` (only tracks with seen >= min_track_frames take part),
 // largest first; clusters of fewer than 3 tracks are not returned.

@@ -56,7 +56,8 @@ bool score_pair(const DiscoveredBody& A, const DiscoveredBody& B, int a, int b,
 
 }  // namespace
 
-TopologyResult infer_topology(const std::vector<DiscoveredBody>& bodies, const DiscoverOptions& opt) {
+TopologyResult infer_topology(const std::vector<DiscoveredBody>& bodies,
+                              const DiscoverOptions& opt) {
   TopologyResult out;
   const int nb = static_cast<int>(bodies.size());
   std::vector<JointEdge> candidates;
@@ -64,18 +65,22 @@ TopologyResult infer_topology(const std::vector<DiscoveredBody>& bodies, const D
     for (int b = a + 1; b < nb; ++b) {
       JointEdge e;
       bool low = false;
-      if (score_pair(bodies[static_cast<std::size_t>(a)], bodies[static_cast<std::size_t>(b)], a, b, opt, e, low))
+      if (score_pair(bodies[static_cast<std::size_t>(a)], bodies[static_cast<std::size_t>(b)], a, b,
+                     opt, e, low))
         candidates.push_back(e);
       else if (low)
         out.low_motion_pairs.emplace_back(a, b);
     }
   }
-  std::stable_sort(candidates.begin(), candidates.end(),
-                   [](const JointEdge& x, const JointEdge& y) { return x.residual_mm < y.residual_mm; });
+  std::stable_sort(
+      candidates.begin(), candidates.end(),
+      [](const JointEdge& x, const JointEdge& y) { return x.residual_mm < y.residual_mm; });
   std::vector<int> comp(static_cast<std::size_t>(nb));
   std::iota(comp.begin(), comp.end(), 0);
   auto find = [&](int x) {
-    while (comp[static_cast<std::size_t>(x)] != x) x = comp[static_cast<std::size_t>(x)] = comp[static_cast<std::size_t>(comp[static_cast<std::size_t>(x)])];
+    while (comp[static_cast<std::size_t>(x)] != x)
+      x = comp[static_cast<std::size_t>(x)] =
+          comp[static_cast<std::size_t>(comp[static_cast<std::size_t>(x)])];
     return x;
   };
   std::vector<std::vector<std::pair<int, const JointEdge*>>> adj(static_cast<std::size_t>(nb));
@@ -97,11 +102,14 @@ TopologyResult infer_topology(const std::vector<DiscoveredBody>& bodies, const D
     }
     trees[static_cast<std::size_t>(tree_of[static_cast<std::size_t>(r)])].push_back(b);
   }
-  std::stable_sort(trees.begin(), trees.end(), [](const auto& x, const auto& y) { return x.size() > y.size(); });
+  std::stable_sort(trees.begin(), trees.end(),
+                   [](const auto& x, const auto& y) { return x.size() > y.size(); });
   for (const auto& tree : trees) {
     int root = tree.front();
     for (int b : tree)
-      if (bodies[static_cast<std::size_t>(b)].motion_rms_mm < bodies[static_cast<std::size_t>(root)].motion_rms_mm) root = b;
+      if (bodies[static_cast<std::size_t>(b)].motion_rms_mm <
+          bodies[static_cast<std::size_t>(root)].motion_rms_mm)
+        root = b;
     std::vector<char> seen(static_cast<std::size_t>(nb), 0);
     std::queue<int> q;
     q.push(root);
@@ -118,7 +126,8 @@ TopologyResult infer_topology(const std::vector<DiscoveredBody>& bodies, const D
         JointEdge j = *e;
         if (j.parent != p) {  // re-estimate with the parent on the root's side
           bool low = false;
-          score_pair(bodies[static_cast<std::size_t>(p)], bodies[static_cast<std::size_t>(c)], p, c, opt, j, low);
+          score_pair(bodies[static_cast<std::size_t>(p)], bodies[static_cast<std::size_t>(c)], p, c,
+                     opt, j, low);
           j.parent = p;
           j.child = c;
         }

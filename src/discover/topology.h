@@ -31,12 +31,13 @@ struct JointEdge {
 };
 
 struct TopologyResult {
-  std::vector<int> body_order;   // discovered body indices in output order
-  std::vector<JointEdge> joints; // parents before children
+  std::vector<int> body_order;    // discovered body indices in output order
+  std::vector<JointEdge> joints;  // parents before children
   std::vector<std::string> notes;
   std::vector<std::pair<int, int>> low_motion_pairs;  // (a, b) with too little motion
 };
 
-TopologyResult infer_topology(const std::vector<DiscoveredBody>& bodies, const DiscoverOptions& options);
+TopologyResult infer_topology(const std::vector<DiscoveredBody>& bodies,
+                              const DiscoverOptions& options);
 
 }  // namespace mocap::discover

@@ -22,11 +22,13 @@ int main(int argc, char** argv) {
     }
     if (const char* dump = std::getenv("DISCOVER_DUMP_TRACKS")) {  // tracks for analysis
       FILE* out = std::fopen(dump, "w");
-      const auto tracks = mocap::discover::track_points(*points, mocap::discover::DiscoverOptions{});
+      const auto tracks =
+          mocap::discover::track_points(*points, mocap::discover::DiscoverOptions{});
       for (std::size_t k = 0; k < tracks.size(); ++k)
         for (int f = tracks[k].first; f <= tracks[k].last(); ++f)
           if (tracks[k].has(f))
-            std::fprintf(out, "%zu,%lld,%.3f,%.3f,%.3f\n", k, static_cast<long long>(points->frames[static_cast<std::size_t>(f)].frame),
+            std::fprintf(out, "%zu,%lld,%.3f,%.3f,%.3f\n", k,
+                         static_cast<long long>(points->frames[static_cast<std::size_t>(f)].frame),
                          tracks[k].at(f).x(), tracks[k].at(f).y(), tracks[k].at(f).z());
       std::fclose(out);
     }

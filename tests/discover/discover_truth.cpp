@@ -22,12 +22,14 @@ std::string DiscoverTruth::describe() const {
   std::snprintf(buf, sizeof buf,
                 "true bodies %d, complete %d, wrong markers %d, unmatched markers %d, topology %s, "
                 "ball centre %.3f mm, hinge axis %.3f deg, hinge line %.3f mm",
-                true_bodies, bodies_complete, wrong_markers, unmatched_markers, topology_ok ? "ok" : "WRONG",
-                worst_ball_center_mm, worst_hinge_axis_deg, worst_hinge_line_mm);
+                true_bodies, bodies_complete, wrong_markers, unmatched_markers,
+                topology_ok ? "ok" : "WRONG", worst_ball_center_mm, worst_hinge_axis_deg,
+                worst_hinge_line_mm);
   return buf;
 }
 
-Expected<DiscoverTruth> compare_with_truth(const std::string& rec, const discover::DiscoverResult& r) {
+Expected<DiscoverTruth> compare_with_truth(const std::string& rec,
+                                           const discover::DiscoverResult& r) {
   auto targets = load_targets(rec + "/targets.yaml");
   if (!targets) return targets.error();
   auto model = load_model(rec + "/gt/model_true.yaml", *targets);
@@ -119,12 +121,14 @@ Expected<DiscoverTruth> compare_with_truth(const std::string& rec, const discove
       } else {
         const Vec3 a_disc = obs.T_world_body.linear() * dj->axis_parent;
         const Vec3 a_true = (Tt.linear() * tj.axis_parent).normalized();
-        axis.push_back(std::acos(std::min(1.0, std::abs(a_disc.normalized().dot(a_true)))) * 57.29577951308232);
+        axis.push_back(std::acos(std::min(1.0, std::abs(a_disc.normalized().dot(a_true)))) *
+                       57.29577951308232);
         const Vec3 v = c_disc - c_true;
         line.push_back((v - v.dot(a_true) * a_true).norm());
       }
     }
-    if (tj.type == JointType::kBall) out.worst_ball_center_mm = std::max(out.worst_ball_center_mm, median(centre));
+    if (tj.type == JointType::kBall)
+      out.worst_ball_center_mm = std::max(out.worst_ball_center_mm, median(centre));
     else {
       out.worst_hinge_axis_deg = std::max(out.worst_hinge_axis_deg, median(axis));
       out.worst_hinge_line_mm = std::max(out.worst_hinge_line_mm, median(line));

@@ -25,7 +25,8 @@ namespace {
 
 using test::run_mocap;
 
-void expect_tracks_stay_on_one_marker(const std::string& rec, const discover::PointSequence& points) {
+void expect_tracks_stay_on_one_marker(const std::string& rec,
+                                      const discover::PointSequence& points) {
   auto gt = read_gt_markers_csv(rec + "/gt/markers.csv");
   ASSERT_TRUE(gt) << gt.error().message;
   std::map<std::int64_t, std::vector<const GtMarker*>> by_frame;
@@ -77,10 +78,12 @@ void expect_true_angles(const std::string& angles_csv, const std::string& truth_
       ball_f0 = &r;
       ball_t0 = &t;
     }
-    ball.emplace_back(r.q_parent_child.angularDistance(ball_f0->q_parent_child) * 57.29577951308232,
-                      t.q_parent_child.angularDistance(ball_t0->q_parent_child) * 57.29577951308232);
+    ball.emplace_back(
+        r.q_parent_child.angularDistance(ball_f0->q_parent_child) * 57.29577951308232,
+        t.q_parent_child.angularDistance(ball_t0->q_parent_child) * 57.29577951308232);
   }
-  // The tracker finds this scene's lower arm in part of the frames only (also with the true targets).
+  // The tracker finds this scene's lower arm in part of the frames only (also with the true
+  // targets).
   ASSERT_GE(diff.size(), 30U);
   ASSERT_GE(ball.size(), 100U);
   auto spread = [](const std::vector<double>& v) {
@@ -123,7 +126,8 @@ TEST(DiscoverSim, SimulatedRecordingAgainstTruth) {
   ASSERT_FALSE(r->model.joints.empty());
   EXPECT_EQ(r->model.joints.front().parent, "body0");  // the root: the still torso
 
-  auto disc = run_mocap("discover " + rec + " --out " + out + " --urdf " + out + "/robot.urdf --stats", 120);
+  auto disc = run_mocap(
+      "discover " + rec + " --out " + out + " --urdf " + out + "/robot.urdf --stats", 120);
   ASSERT_EQ(disc.exit_code, 0) << disc.output;
   EXPECT_NE(disc.output.find("discovered 3 bodies and 2 joints"), std::string::npos) << disc.output;
   EXPECT_NE(test::read_file(out + "/robot.urdf").find("<robot"), std::string::npos);
@@ -142,12 +146,14 @@ TEST(DiscoverErrors, TooFewFramesAndStaticScene) {
   discover::DiscoverOptions opt;
   auto r = discover::discover_model(seq, opt, "rec");
   ASSERT_FALSE(r);
-  EXPECT_EQ(r.error().message, "rec: 10 frames, at least 30 are needed to discover bodies and joints");
+  EXPECT_EQ(r.error().message,
+            "rec: 10 frames, at least 30 are needed to discover bodies and joints");
   for (int f = 10; f < 60; ++f)
     seq.frames.push_back({f, f * 10000000LL, {Vec3(0, 0, 0), Vec3(50, 0, 0), Vec3(0, 60, 0)}});
   r = discover::discover_model(seq, opt, "rec");
   ASSERT_FALSE(r);
-  EXPECT_NE(r.error().message.find("rec: nothing moves (a static scene)"), std::string::npos) << r.error().message;
+  EXPECT_NE(r.error().message.find("rec: nothing moves (a static scene)"), std::string::npos)
+      << r.error().message;
 }
 
 }  // namespace

@@ -32,13 +32,19 @@ TEST(DiscoverCli, BadInputIsOneLineNamingTheRecording) {
   EXPECT_EQ(lines_of(r.output), 1) << r.output;
   EXPECT_NE(r.output.find("short: 12 frames, at least 30"), std::string::npos) << r.output;
   // A static scene: one pose held.
-  ASSERT_EQ(run_mocap("simulate --out " + dir.file("still") + " --frames 32 --motion poses --poses 1", 60).exit_code, 0);
+  ASSERT_EQ(
+      run_mocap("simulate --out " + dir.file("still") + " --frames 32 --motion poses --poses 1", 60)
+          .exit_code,
+      0);
   r = run_mocap("discover " + dir.file("still") + " --out " + dir.file("o"), 30);
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_EQ(lines_of(r.output), 1) << r.output;
   EXPECT_NE(r.output.find("still: nothing moves"), std::string::npos) << r.output;
   // One body only: the whole robot turned rigidly (joints fixed).
-  ASSERT_EQ(run_mocap("simulate --out " + dir.file("rigid") + " --frames 40 --motion viewpoints", 60).exit_code, 0);
+  ASSERT_EQ(
+      run_mocap("simulate --out " + dir.file("rigid") + " --frames 40 --motion viewpoints", 60)
+          .exit_code,
+      0);
   r = run_mocap("discover " + dir.file("rigid") + " --out " + dir.file("o"), 30);
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_EQ(lines_of(r.output), 1) << r.output;
