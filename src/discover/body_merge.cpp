@@ -1,3 +1,6 @@
+// Design: the merge of one body built twice (body_builder_detail.h, docs/discover.md):
+// by constant relative poses where both are posed, else by the rigid alignment of >= 3
+// markers for bodies never posed in the same frame.
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
