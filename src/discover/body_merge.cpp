@@ -1,6 +1,6 @@
 // Design: the merge of one body built twice (body_builder_detail.h, docs/discover.md):
 // by constant relative poses where both are posed, else by the rigid alignment of >= 3
-// markers for bodies never posed in the same frame.
+// markers checked against the frames where both are posed.
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
@@ -38,13 +38,12 @@ bool same_by_poses(const Builder& A, const Builder& B, Iso3& T_ab) {
   return true;
 }
 
-// Shape-based test for bodies never posed in the same frame (disjoint time windows):
+// Shape-based test (bodies mostly posed in different time windows):
 // at least 3 markers of B align with distinct markers of A by one rigid motion, every
 // residual within 4 fit tolerances, and no marker of B lands where A has none nearby
-// but within one marker diameter (an inconsistent overlap).
+// but within one marker diameter (an inconsistent overlap); in every frame where both
+// are posed, their relative pose must be that alignment (within 1 deg and 2 mm).
 bool same_by_shape(const Builder& A, const Builder& B, Iso3& T_ab) {
-  for (std::size_t f = 0; f < A.frames(); ++f)
-    if (A.body.found[f] && B.body.found[f]) return false;  // seen together: two bodies
   const auto& ma = A.body.markers_body;
   const auto& mb = B.body.markers_body;
   const double tol = 4.0 * A.opt.body_fit_tolerance_mm();
@@ -89,7 +88,16 @@ bool same_by_shape(const Builder& A, const Builder& B, Iso3& T_ab) {
                 T_ab = T;
               }
             }
-  return best >= 3;
+  if (best < 3) return false;
+  // Frames where both are posed must show that same relative pose (else: two bodies).
+  for (std::size_t f = 0; f < A.frames(); ++f) {
+    if (!A.body.found[f] || !B.body.found[f]) continue;
+    const Iso3 T = A.body.T_world_body[f].inverse() * B.body.T_world_body[f];
+    if (Eigen::AngleAxisd(T.linear() * T_ab.linear().transpose()).angle() * kRadToDeg > 1.0 ||
+        (T.translation() - T_ab.translation()).norm() > 2.0)
+      return false;
+  }
+  return true;
 }
 
 }  // namespace
