@@ -1,0 +1,140 @@
+// Design: the merge of one body built twice (body_builder_detail.h, docs/discover.md):
+// by constant relative poses where both are posed, else by the rigid alignment of >= 3
+// markers checked against the frames where both are posed.
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+
+#include "discover/body_builder_detail.h"
+
+namespace mocap::discover::detail {
+namespace {
+
+// The same body built twice from clusters of different time windows (occlusions cut
+// every track between them): B is A when A's target, identified among B's tracks (and
+// B's among A's), keeps one constant pose relative to B (rotation within 1 deg,
+// translation within 2 mm) over at least min_covisible_frames frames in which A turned
+// by min_pair_rotation_deg. B's markers then join A's (or are left to the pool).
+// Pose-based test (above); returns false when it cannot decide or says no.
+bool same_by_poses(const Builder& A, const Builder& B, Iso3& T_ab) {
+  Builder a = A, b = B;
+  a.extend_poses(B.members);
+  b.extend_poses(A.members);
+  std::vector<int> fs;
+  for (std::size_t f = 0; f < a.frames(); ++f)
+    if (a.body.found[f] && b.body.found[f]) fs.push_back(static_cast<int>(f));
+  if (static_cast<int>(fs.size()) < A.opt.min_covisible_frames) return false;
+  if (a.rotation_range_deg(fs) < A.opt.min_pair_rotation_deg) return false;
+  std::vector<Iso3> rel;
+  for (int f : fs)
+    rel.push_back(a.body.T_world_body[static_cast<std::size_t>(f)].inverse() *
+                  b.body.T_world_body[static_cast<std::size_t>(f)]);
+  T_ab = rel[rel.size() / 2];
+  for (const Iso3& T : rel) {
+    if (Eigen::AngleAxisd(T.linear() * T_ab.linear().transpose()).angle() * kRadToDeg > 1.0)
+      return false;
+    if ((T.translation() - T_ab.translation()).norm() > 2.0) return false;
+  }
+  return true;
+}
+
+// Shape-based test (bodies mostly posed in different time windows):
+// at least 3 markers of B align with distinct markers of A by one rigid motion, every
+// residual within 4 fit tolerances, and no marker of B lands where A has none nearby
+// but within one marker diameter (an inconsistent overlap); in every frame where both
+// are posed, their relative pose must be that alignment (within 1 deg and 2 mm).
+bool same_by_shape(const Builder& A, const Builder& B, Iso3& T_ab) {
+  const auto& ma = A.body.markers_body;
+  const auto& mb = B.body.markers_body;
+  const double tol = 4.0 * A.opt.body_fit_tolerance_mm();
+  int best = 0;
+  double best_rms = 1e300;
+  const std::size_t na = ma.size(), nb = mb.size();
+  for (std::size_t i = 0; i < nb; ++i)
+    for (std::size_t j = i + 1; j < nb; ++j)
+      for (std::size_t k = j + 1; k < nb; ++k)
+        for (std::size_t p = 0; p < na; ++p)
+          for (std::size_t q = 0; q < na; ++q)
+            for (std::size_t r = 0; r < na; ++r) {
+              if (p == q || q == r || p == r) continue;
+              auto close = [&](std::size_t x, std::size_t y, std::size_t u, std::size_t v) {
+                return std::abs((mb[x] - mb[y]).norm() - (ma[u] - ma[v]).norm()) <= tol;
+              };
+              if (!close(i, j, p, q) || !close(j, k, q, r) || !close(i, k, p, r)) continue;
+              Eigen::Matrix3d S, D;
+              S << mb[i], mb[j], mb[k];
+              D << ma[p], ma[q], ma[r];
+              Iso3 T;
+              T.matrix() = Eigen::umeyama(S, D, false);
+              int matched = 0;
+              double sum2 = 0.0;
+              bool conflict = false;
+              for (std::size_t m = 0; m < nb; ++m) {
+                double d_min = 1e300;
+                for (std::size_t n = 0; n < na; ++n)
+                  d_min = std::min(d_min, (T * mb[m] - ma[n]).norm());
+                if (d_min <= tol) {
+                  ++matched;
+                  sum2 += d_min * d_min;
+                } else if (d_min < A.opt.marker_diameter_mm) {
+                  conflict = true;
+                }
+              }
+              if (conflict || matched < 3) continue;
+              const double rms = std::sqrt(sum2 / matched);
+              if (matched > best || (matched == best && rms < best_rms)) {
+                best = matched;
+                best_rms = rms;
+                T_ab = T;
+              }
+            }
+  if (best < 3) return false;
+  // Frames where both are posed must show that same relative pose (else: two bodies).
+  for (std::size_t f = 0; f < A.frames(); ++f) {
+    if (!A.body.found[f] || !B.body.found[f]) continue;
+    const Iso3 T = A.body.T_world_body[f].inverse() * B.body.T_world_body[f];
+    if (Eigen::AngleAxisd(T.linear() * T_ab.linear().transpose()).angle() * kRadToDeg > 1.0 ||
+        (T.translation() - T_ab.translation()).norm() > 2.0)
+      return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+bool merge_if_same(Builder& A, const Builder& B, std::vector<int>& released) {
+  Iso3 T_ab = Iso3::Identity();
+  if (!same_by_poses(A, B, T_ab) && !same_by_shape(A, B, T_ab)) return false;
+  for (std::size_t m = 0; m < B.body.markers_body.size(); ++m) {
+    const Vec3 X_a = T_ab * B.body.markers_body[m];
+    int nearest = -1;
+    double d_min = 1e300;
+    for (std::size_t k = 0; k < A.body.markers_body.size(); ++k) {
+      const double d = (A.body.markers_body[k] - X_a).norm();
+      if (d < d_min) {
+        d_min = d;
+        nearest = static_cast<int>(k);
+      }
+    }
+    const auto& tracks_m = B.body.marker_tracks[m];
+    bool coexists = false;
+    if (nearest >= 0)
+      for (int ti : tracks_m) coexists = coexists || A.overlaps_marker(ti, nearest);
+    int target = -1;
+    if (d_min <= 0.25 * A.opt.marker_diameter_mm && !coexists)
+      target = nearest;
+    else if (d_min >= A.opt.marker_diameter_mm)
+      target = static_cast<int>(A.body.markers_body.size());
+    for (int ti : tracks_m) {
+      if (target < 0) {
+        released.push_back(ti);
+        continue;
+      }
+      A.place(ti, target, X_a);
+    }
+  }
+  A.compute_poses();
+  return true;
+}
+
+}  // namespace mocap::discover::detail

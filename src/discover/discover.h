@@ -1,0 +1,47 @@
+// Design: `mocap discover` as a library: from the 3D points of a recording to
+// targets.yaml, joints.yaml and the calibrated model (docs/discover.md). Steps:
+// point_tracker.h (short-term tracks) -> rigid_groups.h (rigid clusters) ->
+// body_builder.h (targets, poses) -> topology.h (joint tree and types) ->
+// src/kinematics calibrate_joints (Eq. 2 / rank-5 + Ceres refinement, exactly as
+// `mocap calibrate`). Bad recordings (too few frames, nothing moving, no body or a
+// single body) are one-line errors prefixed by the recording's name; doubts are
+// warnings (unplaced tracks, symmetric targets, too little motion), never guesses.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/expected.h"
+#include "discover/discover_types.h"
+#include "formats/joints_yaml.h"
+#include "formats/targets_yaml.h"
+#include "kinematics/calibrate.h"
+
+namespace mocap::discover {
+
+struct DiscoverStats {
+  int frames = 0;
+  long long points = 0;
+  int tracks = 0;       // all short-term tracks
+  int long_tracks = 0;  // seen in >= min_track_frames frames
+  int clusters = 0;
+  int unplaced_tracks = 0;
+  double seconds_tracking = 0.0, seconds_grouping = 0.0, seconds_bodies = 0.0,
+         seconds_topology = 0.0, seconds_calibration = 0.0;
+};
+
+struct DiscoverResult {
+  TargetSet targets;    // body0..N-1: joined trees first (root, then breadth-first)
+  JointModel topology;  // joints.yaml (names "<parent>_<child>")
+  JointModel model;     // model.yaml (calibrated; empty when there is no joint)
+  kinematics::CalibrationResult calibration;
+  kinematics::CalibrationInput input;  // poses and markers per frame (targets' body order)
+  std::vector<std::string> warnings;   // one line each
+  DiscoverStats stats;
+};
+
+// `label` (the recording folder) prefixes error messages.
+Expected<DiscoverResult> discover_model(const PointSequence& points, const DiscoverOptions& options,
+                                        const std::string& label);
+
+}  // namespace mocap::discover

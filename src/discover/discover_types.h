@@ -1,0 +1,74 @@
+// Design: the value types passed between the steps of `mocap discover` (docs/discover.md):
+// the 3D points of every frame (frame_points.h), the short-term point tracks
+// (point_tracker.h), and the options of every step in one struct with the stated
+// bounds (speed, acceleration, point noise) from which the gates and the rigidity
+// tolerances are derived. Offline, set-up style code: plain vectors, no hot path.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/types.h"
+#include "kinematics/linear_estimation.h"
+
+namespace mocap::discover {
+
+// The triangulated (unambiguous, whole-blob) 3D points of one frame, world frame, mm.
+struct FramePoints {
+  std::int64_t frame = 0;
+  std::int64_t timestamp_ns = 0;
+  std::vector<Vec3> X_world_mm;
+};
+
+struct PointSequence {
+  std::vector<FramePoints> frames;
+  int frames_missing_camera = 0;  // frames a camera did not deliver (no 3D points)
+  int points_dropped = 0;         // ambiguous or merged-blob candidates left out
+};
+
+// A short-term track of one unlabelled point: X_world_mm[i] is its position in frame
+// `first + i` (frame indices into PointSequence::frames); NaN where it was coasted over
+// a short gap.
+struct PointTrack {
+  int first = 0;
+  std::vector<Vec3> X_world_mm;
+  int seen = 0;  // frames with a measurement
+
+  int last() const noexcept { return first + static_cast<int>(X_world_mm.size()) - 1; }
+  bool has(int f) const noexcept {
+    return f >= first && f <= last() &&
+           !std::isnan(X_world_mm[static_cast<std::size_t>(f - first)].x());
+  }
+  const Vec3& at(int f) const noexcept { return X_world_mm[static_cast<std::size_t>(f - first)]; }
+};
+
+struct DiscoverOptions {
+  // Stated bounds.
+  double max_speed_mm_per_s = 3000.0;    // fastest marker
+  double max_accel_mm_per_s2 = 40000.0;  // fastest change of a marker's velocity (~4 g)
+  double point_noise_mm = 0.15;          // 1-sigma noise of a triangulated marker, per axis
+  double marker_diameter_mm = 12.0;      // written to targets.yaml; closest marker spacing
+  // Tracking.
+  int max_gap_frames = 1;    // a track coasts over this many missed frames
+  double gate_sigmas = 4.0;  // noise part of every gate, in sigmas
+  // Grouping.
+  int min_track_frames = 10;               // shorter tracks are ignored (ghosts, glints)
+  int min_covisible_frames = 20;           // a pair test needs this many common frames
+  double min_pair_rotation_deg = 10.0;     // the pair's direction must turn this much
+  double static_tolerance_mm = 1.0;        // a point moving less is static
+  double min_scene_speed_mm_per_s = 20.0;  // a point moving faster makes the scene "moving"
+  int max_pair_frames = 400;               // pair statistics on at most this many frames
+  // Joints (Eq. 2 / rank-5 hinge tests as in src/kinematics).
+  kinematics::LinearOptions linear{20, 2.0, 0.25};
+  double max_joint_residual_mm = 3.0;  // linear fit residual above this: not a joint
+  int min_frames = 30;                 // fewer frames in the recording: error
+  bool refine = true;                  // Ceres refinement of the joints
+
+  // Derived tolerances (docs/discover.md).
+  double pair_distance_std_mm() const noexcept { return 3.0 * std::sqrt(2.0) * point_noise_mm; }
+  double body_fit_tolerance_mm() const noexcept { return 4.0 * point_noise_mm + 0.2; }
+};
+
+}  // namespace mocap::discover

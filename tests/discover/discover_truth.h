@@ -1,0 +1,36 @@
+// Design: compares a discover result with the simulator's ground truth (test and
+// acceptance-measurement helper). Frames are aligned through the poses: for every frame
+// in which a discovered body was found, its markers T_world_body * m are matched to the
+// true markers of that frame (gt/poses.csv + the true targets.yaml) within 3 mm; a
+// discovered body maps to the true body most of its marker matches fall on. Joint
+// parameters are compared in world terms at every frame with both poses: the ball
+// centre (and a hinge's point, as its distance to the true axis line) and the hinge
+// axis direction (up to sign).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/expected.h"
+#include "discover/discover.h"
+
+namespace mocap::test {
+
+struct DiscoverTruth {
+  int true_bodies = 0;
+  int bodies_complete = 0;            // true bodies found with all but at most one marker
+  int wrong_markers = 0;              // discovered markers on another body's marker (or on none)
+  int unmatched_markers = 0;          // discovered markers matching no true marker
+  std::vector<int> body_map;          // discovered body -> true body index (-1: none)
+  bool topology_ok = false;           // same joints (parent, child, type) as the true model
+  double worst_ball_center_mm = 0.0;  // median over frames, worst joint
+  double worst_hinge_axis_deg = 0.0;
+  double worst_hinge_line_mm = 0.0;  // distance of the hinge point from the true axis line
+  std::string describe() const;
+};
+
+// `rec`: the simulated recording (targets.yaml, gt/poses.csv, gt/model_true.yaml).
+Expected<DiscoverTruth> compare_with_truth(const std::string& rec,
+                                           const discover::DiscoverResult& result);
+
+}  // namespace mocap::test
