@@ -5,6 +5,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/rotation.h"
+#include "track/labelled_markers.h"
+
 namespace mocap::pipeline {
 
 void make_joints_message(std::uint64_t sequence, std::int64_t capture_ns, const FrameOutput& out,
@@ -70,25 +73,23 @@ void make_frame_result(std::uint64_t sequence, std::int64_t capture_ns, const Ta
     rb.found = 1;
     rb.markers = static_cast<std::uint8_t>(std::clamp(pose.markers, 0, 255));
     rb.rms_mm = static_cast<float>(pose.rms_mm);
-    Quat q(pose.T_world_body.linear());
-    q.normalize();
-    if (q.w() < 0.0) q.coeffs() = -q.coeffs();
+    const Quat q = canonical_quat(pose.T_world_body.linear());
     rb.q_world_body = {q.w(), q.x(), q.y(), q.z()};
     const Vec3 t = pose.T_world_body.translation();
     rb.t_world_body_mm = {t.x(), t.y(), t.z()};
-    const std::vector<Vec3>& model = targets.bodies[static_cast<std::size_t>(b)].markers_body;
-    const std::size_t nk = std::min<std::size_t>(model.size(), pose.point_index_of_marker.size());
-    for (std::size_t k = 0; k < nk && markers < publish::kMaxResultMarkers; ++k) {
-      const int idx = pose.point_index_of_marker[k];
-      if (idx < 0 || idx >= out.points.size()) continue;
-      const Vec3& X = out.points[idx].X_world;
-      publish::ResultMarker& m = result.markers[static_cast<std::size_t>(markers++)];
-      m.body = static_cast<std::uint8_t>(b);
-      m.marker = static_cast<std::uint8_t>(k);
-      m.residual_mm = static_cast<float>((X - pose.T_world_body * model[k]).norm());
-      m.X_world_mm = {static_cast<float>(X.x()), static_cast<float>(X.y()),
-                      static_cast<float>(X.z())};
-    }
+  }
+  // The labelled markers: the one list of the frame (track/labelled_markers.h).
+  LabelledMarkers labelled;  // on the stack: fixed size, no allocation
+  label_markers(out, targets, labelled);
+  for (int i = 0; i < labelled.count && markers < publish::kMaxResultMarkers; ++i) {
+    const LabelledMarker& l = labelled.items[static_cast<std::size_t>(i)];
+    if (l.body >= bodies) continue;
+    publish::ResultMarker& m = result.markers[static_cast<std::size_t>(markers++)];
+    m.body = static_cast<std::uint8_t>(l.body);
+    m.marker = static_cast<std::uint8_t>(l.marker);
+    m.residual_mm = static_cast<float>(l.residual_mm);
+    m.X_world_mm = {static_cast<float>(l.X_world_mm.x()), static_cast<float>(l.X_world_mm.y()),
+                    static_cast<float>(l.X_world_mm.z())};
   }
   result.marker_count = markers;
 }
