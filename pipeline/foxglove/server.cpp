@@ -75,6 +75,7 @@ Expected<std::unique_ptr<Server>> Server::create(const ServerOptions& options,
   if (!ec) impl->acceptor.bind(endpoint, ec);
   if (!ec) impl->acceptor.listen(asio::socket_base::max_listen_connections, ec);
   if (ec) return make_error(key, where, "cannot listen: " + ec.message());
+  impl->port = impl->acceptor.local_endpoint(ec).port();  // the bound port (also for port 0)
   return std::unique_ptr<Server>(new Server(std::move(impl)));
 }
 
@@ -91,11 +92,7 @@ void Server::stop() noexcept {
   if (impl_->thread.joinable()) impl_->thread.join();
 }
 
-std::uint16_t Server::port() const noexcept {
-  boost::system::error_code ec;
-  const auto endpoint = impl_->acceptor.local_endpoint(ec);
-  return ec ? 0 : endpoint.port();
-}
+std::uint16_t Server::port() const noexcept { return impl_->port; }
 
 void Server::broadcast(std::uint32_t channel_id, std::uint64_t timestamp_ns,
                        std::shared_ptr<const std::string> payload) {

@@ -36,6 +36,7 @@ struct Server::Impl {
   std::vector<ChannelInfo> channels;
   std::string server_info;  // JSON texts sent to every new client
   std::string advertise;
+  std::uint16_t port = 0;  // bound port, set at create (read from any thread)
   boost::asio::io_context ioc{1};
   boost::asio::ip::tcp::acceptor acceptor{ioc};
   boost::asio::steady_timer tick_timer{ioc};
