@@ -13,13 +13,13 @@ namespace mocap::pipeline {
 
 Expected<std::unique_ptr<Pipeline>> Pipeline::create(FrameProcessor processor,
                                                      std::array<hal::Camera*, 2> cameras,
-                                                     std::vector<JointsSink*> sinks,
+                                                     std::vector<publish::OutputSink*> sinks,
                                                      const PipelineOptions& options) {
   for (int c = 0; c < 2; ++c) {
     if (cameras[static_cast<std::size_t>(c)] == nullptr)
       return make_error("pipeline", "cameras", "camera " + std::to_string(c) + " is missing");
   }
-  for (const JointsSink* s : sinks) {
+  for (const publish::OutputSink* s : sinks) {
     if (s == nullptr) return make_error("pipeline", "sinks", "null sink");
   }
   // Lower bound: the period 1e9 / rate must fit the int64 nanoseconds of the capture loop.
@@ -51,7 +51,7 @@ Expected<std::unique_ptr<Pipeline>> Pipeline::create(FrameProcessor processor,
 }
 
 Pipeline::Pipeline(FrameProcessor processor, std::array<hal::Camera*, 2> cameras,
-                   std::vector<JointsSink*> sinks, const PipelineOptions& options)
+                   std::vector<publish::OutputSink*> sinks, const PipelineOptions& options)
     : processor_(std::move(processor)),
       cameras_(cameras),
       sinks_(std::move(sinks)),

@@ -1,8 +1,8 @@
 // Design: the live real-time pipeline: five pinned threads (stage_table.h) passing
 // preallocated buffers through lock-free SPSC rings.
 //
-//   capture --Frame ring[c]--> detect c --blob slot pool[c]--> identify --msg pool--> publish
-//      ^                          |                             (pair by sequence,   (sinks)
+//   capture --Frame ring[c]--> detect c --blob slot pool[c]--> identify --result pool--> publish
+//      ^                          |                             (pair by sequence,  (OutputSinks)
 //      +------ return ring[c] ----+ (camera buffer back          stereo, identify,
 //                                    right after detection)      angles)
 //
@@ -41,8 +41,9 @@
 #include "hal/rt/spsc_ring.h"
 #include "hal/rt/thread.h"
 #include "pipeline/doorbell.h"
-#include "pipeline/joints_sink.h"
+#include "pipeline/frame_result_builder.h"
 #include "pipeline/latency_histogram.h"
+#include "pipeline/publish/output_sink.h"
 #include "pipeline/stage_counters.h"
 #include "pipeline/stage_table.h"
 #include "pipeline/timestamp_check.h"
@@ -114,6 +115,10 @@ struct PipelineHealth {
   // (timestamp_backwards_camN + timestamp_jumps_camN).
   std::uint64_t detect_overflow_frames[2] = {0, 0};
   std::uint64_t timestamp_steps[2] = {0, 0};
+  // Summed over the output sinks (OutputCounters): frames a transport refused, and frames
+  // a slow sink's drop-oldest queue dropped.
+  std::uint64_t output_failures = 0;
+  std::uint64_t output_dropped = 0;
 };
 
 struct PipelineStats {
@@ -133,7 +138,7 @@ class Pipeline {
   // drives them from its capture thread); sinks and cameras must outlive the pipeline.
   static Expected<std::unique_ptr<Pipeline>> create(FrameProcessor processor,
                                                     std::array<hal::Camera*, 2> cameras,
-                                                    std::vector<JointsSink*> sinks,
+                                                    std::vector<publish::OutputSink*> sinks,
                                                     const PipelineOptions& options);
   ~Pipeline();
   Pipeline(const Pipeline&) = delete;
@@ -179,7 +184,7 @@ class Pipeline {
     bool present = false;
   };
   struct MsgSlot {
-    client::JointsMessage msg;
+    publish::FrameResult frame;  // the frame's whole result, for every output sink
   };
   struct Counters {
     rt::Counter triggered, trigger_errors, dequeue_timeouts[2], dequeue_errors;
@@ -215,7 +220,7 @@ class Pipeline {
   static constexpr std::int64_t kLockstepTimeoutNs = 1'000'000'000;
 
   Pipeline(FrameProcessor processor, std::array<hal::Camera*, 2> cameras,
-           std::vector<JointsSink*> sinks, const PipelineOptions& options);
+           std::vector<publish::OutputSink*> sinks, const PipelineOptions& options);
 
   // The stage loops (capture_stage.cpp, processing_stages.cpp).
   void capture_loop() noexcept;
@@ -231,7 +236,7 @@ class Pipeline {
 
   FrameProcessor processor_;
   std::array<hal::Camera*, 2> cameras_;
-  std::vector<JointsSink*> sinks_;
+  std::vector<publish::OutputSink*> sinks_;
   PipelineOptions options_;
   std::vector<std::string> notes_;
   bool running_ = false;

@@ -23,6 +23,11 @@ PipelineHealth Pipeline::health() const noexcept {
   if (period > 0 && h.last_publish_ns != 0 && now - h.last_publish_ns < 1'000'000'000)
     h.fps = 1e9 / static_cast<double>(period);
   h.p99_us = lat_->publish.percentile_us(0.99);
+  for (const publish::OutputSink* sink : sinks_) {  // virtual calls, relaxed loads only
+    const publish::OutputCounters oc = sink->counters();
+    h.output_failures += oc.failures;
+    h.output_dropped += oc.dropped;
+  }
   h.max_us = static_cast<double>(lat_->publish.max_ns()) * 1e-3;
   for (std::size_t c = 0; c < 2; ++c) {
     const std::int64_t last = last_frame_ns_[c].load(std::memory_order_relaxed);
@@ -107,6 +112,14 @@ PipelineStats Pipeline::stats() const {
   for (std::size_t i = 0; i < kIdentifyFields.size(); ++i)
     s.counters.emplace_back(std::string("identify_") + kIdentifyFields[i].name,
                             lib.identify.get(i));
+  // Per output sink (the output seam): output_<name>_published/failures/dropped.
+  for (const publish::OutputSink* sink : sinks_) {
+    const publish::OutputCounters oc = sink->counters();
+    const std::string prefix = std::string("output_") + sink->name() + "_";
+    s.counters.emplace_back(prefix + "published", oc.published);
+    s.counters.emplace_back(prefix + "failures", oc.failures);
+    s.counters.emplace_back(prefix + "dropped", oc.dropped);
+  }
   return s;
 }
 

@@ -137,8 +137,8 @@ void Pipeline::identify_loop() noexcept {
     if (options_.observer) options_.observer->observe(sequence, capture_ns, out);
     rt::SlotHandle m;
     if (msg_pool_->acquire(m)) {
-      make_joints_message(sequence, capture_ns, out, (*msg_pool_)[m].msg);
-      if (((*msg_pool_)[m].msg.flags & client::kFlagAllBodiesFound) == 0)
+      make_frame_result(sequence, capture_ns, processor_.targets(), out, (*msg_pool_)[m].frame);
+      if (((*msg_pool_)[m].frame.joints.flags & client::kFlagAllBodiesFound) == 0)
         k.frames_without_result.add();
       msg_pool_->publish(m);
       bells_[index(StageId::kPublish)].ring();
@@ -171,11 +171,12 @@ void Pipeline::publish_loop() noexcept {
       k.publish_skipped.add(pool.skipped() - skipped_seen);
       skipped_seen = pool.skipped();
     }
-    client::JointsMessage& msg = pool[h].msg;
+    publish::FrameResult& frame = pool[h].frame;
+    const client::JointsMessage& msg = frame.joints;
     const std::int64_t t0 = monotonic_ns();
-    msg.publish_ns = t0;
-    for (JointsSink* s : sinks_) {
-      if (!s->publish(msg)) k.sink_failures.add();
+    frame.joints.publish_ns = t0;
+    for (publish::OutputSink* s : sinks_) {
+      if (!s->publish(frame)) k.sink_failures.add();
     }
     const std::int64_t t1 = monotonic_ns();
     const std::uint64_t sequence = msg.sequence;

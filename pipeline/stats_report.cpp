@@ -39,7 +39,7 @@ std::string format_progress_line(double elapsed_s, double interval_s, const Late
       line, sizeof line,
       "t=%.1fs fps=%.1f e2e(last %.1fs, %llu) p50=%.0f p99=%.0f p99.9=%.0f max=%.0f us "
       "published=%llu dropped=%llu cam silent=%lld/%lld ms blob overflow=%llu/%llu "
-      "clock steps=%llu/%llu",
+      "clock steps=%llu/%llu outputs failed/dropped=%llu/%llu",
       elapsed_s, h.fps, interval_s, static_cast<unsigned long long>(e2e.count), e2e.p50_us,
       e2e.p99_us, e2e.p999_us, e2e.max_us, static_cast<unsigned long long>(h.frames_published),
       static_cast<unsigned long long>(h.frames_dropped),
@@ -47,7 +47,9 @@ std::string format_progress_line(double elapsed_s, double interval_s, const Late
       static_cast<unsigned long long>(h.detect_overflow_frames[0]),
       static_cast<unsigned long long>(h.detect_overflow_frames[1]),
       static_cast<unsigned long long>(h.timestamp_steps[0]),
-      static_cast<unsigned long long>(h.timestamp_steps[1]));
+      static_cast<unsigned long long>(h.timestamp_steps[1]),
+      static_cast<unsigned long long>(h.output_failures),
+      static_cast<unsigned long long>(h.output_dropped));
   return line;
 }
 

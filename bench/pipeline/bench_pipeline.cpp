@@ -19,9 +19,11 @@
 namespace mocap::pipeline {
 namespace {
 
-class NullSink final : public JointsSink {
+class NullSink final : public publish::OutputSink {
  public:
-  bool publish(const client::JointsMessage&) noexcept override { return true; }
+  const char* name() const noexcept override { return "null"; }
+  publish::OutputCounters counters() const noexcept override { return {}; }
+  bool publish(const publish::FrameResult&) noexcept override { return true; }
 };
 
 std::shared_ptr<const hal::SimFrameLoop> loop() {

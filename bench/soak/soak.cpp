@@ -187,9 +187,11 @@ class LatencyObserver final : public pipeline::FrameObserver {
   std::vector<std::uint8_t> found_;
 };
 
-class CountingSink final : public pipeline::JointsSink {
+class CountingSink final : public publish::OutputSink {
  public:
-  bool publish(const client::JointsMessage&) noexcept override { return true; }
+  const char* name() const noexcept override { return "counting"; }
+  publish::OutputCounters counters() const noexcept override { return {}; }
+  bool publish(const publish::FrameResult&) noexcept override { return true; }
 };
 
 int run_pipeline(const Args& a, const std::shared_ptr<const hal::SimFrameLoop>& loop) {

@@ -1,5 +1,5 @@
 // Design: the pipeline's health as the service sees it, measured where it matters: at
-// the end of the pipeline. HealthSink is one more JointsSink next to the publishers;
+// the end of the pipeline. HealthSink is one more OutputSink next to the outputs;
 // on the publish thread it counts every message, the frames dropped on the way (gaps
 // in the sequence numbers, which count every triggered frame) and the trigger-to-sink
 // latency in a fixed log-linear histogram (8 sub-buckets per power of two of
@@ -17,7 +17,7 @@
 #include <cstdint>
 
 #include "client/joints_message.h"
-#include "pipeline/joints_sink.h"
+#include "pipeline/publish/output_sink.h"
 
 namespace mocap::service {
 
@@ -49,10 +49,19 @@ class HealthSource {
   virtual void snapshot(HealthSnapshot& out) const noexcept = 0;
 };
 
-class HealthSink final : public pipeline::JointsSink, public HealthSource {
+class HealthSink final : public publish::OutputSink, public HealthSource {
  public:
+  const char* name() const noexcept override { return "health"; }
   // Publish thread only.
-  bool publish(const client::JointsMessage& message) noexcept override;
+  bool publish(const publish::FrameResult& frame) noexcept override {
+    return publish(frame.joints);
+  }
+  bool publish(const client::JointsMessage& message) noexcept;
+  publish::OutputCounters counters() const noexcept override {
+    publish::OutputCounters c;
+    c.published = frames_.load(std::memory_order_relaxed);  // relaxed: a tally
+    return c;
+  }
   void snapshot(HealthSnapshot& out) const noexcept override;
 
  private:

@@ -1,6 +1,8 @@
 // Design: see live_setup.h.
 #include "pipeline/service/live_setup.h"
 
+#include <algorithm>
+
 #include <cstring>
 
 #include "config/tracking_assets.h"
@@ -33,7 +35,29 @@ Expected<config::RunConfig> resolve_run_config(const std::string& path, const Cl
   if (cli.loop_frames) cfg.sim.loop_frames = *cli.loop_frames;
   if (cli.no_realtime) cfg.pipeline.realtime = false;
   if (cli.no_iceoryx) cfg.outputs.iceoryx = false;
+  for (const auto& [name, value] : cli.outputs) {
+    auto& more = cfg.outputs.more;
+    more.erase(std::remove_if(more.begin(), more.end(),
+                              [&](const config::OutputEntry& e) { return e.name == name; }),
+               more.end());
+    more.push_back(config::OutputEntry{name, {value}, "--" + name});
+  }
+  if (auto r = publish::check_outputs(output_requests(cfg, cli)); !r) return r.error();
   return cfg;
+}
+
+std::vector<publish::OutputRequest> output_requests(const config::RunConfig& cfg,
+                                                    const CliOverrides& cli) {
+  const std::string file = cfg.path.empty() ? std::string("outputs") : cfg.path + ": outputs";
+  std::vector<publish::OutputRequest> v;
+  publish::OutputRequest udp{"udp", cfg.outputs.udp, file + ".udp", {}};
+  if (!cli.multicast_if.empty()) udp.options.emplace_back("multicast_if", cli.multicast_if);
+  udp.options.emplace_back("multicast_ttl", std::to_string(cli.multicast_ttl));
+  v.push_back(std::move(udp));
+  v.push_back({"iceoryx", {cfg.outputs.iceoryx ? "true" : "false"}, file + ".iceoryx", {}});
+  for (const config::OutputEntry& e : cfg.outputs.more)
+    v.push_back({e.name, e.values, e.where, {}});
+  return v;
 }
 
 int check_config_command(const std::string& path) {
@@ -42,9 +66,15 @@ int check_config_command(const std::string& path) {
     std::fprintf(stderr, "mocap: %s\n", cfg.error().message.c_str());
     return 1;
   }
-  std::printf("%s: OK (%s cameras, %.0f Hz, %zu UDP destination(s), iceoryx %s)\n", path.c_str(),
+  if (auto r = publish::check_outputs(output_requests(*cfg, CliOverrides{})); !r) {
+    std::fprintf(stderr, "mocap: %s\n", r.error().message.c_str());
+    return 1;
+  }
+  std::string more;
+  for (const config::OutputEntry& e : cfg->outputs.more) more += ", " + e.name;
+  std::printf("%s: OK (%s cameras, %.0f Hz, %zu UDP destination(s), iceoryx %s%s)\n", path.c_str(),
               config::to_string(cfg->cameras[0].backend), cfg->pipeline.trigger_rate_hz,
-              cfg->outputs.udp.size(), cfg->outputs.iceoryx ? "on" : "off");
+              cfg->outputs.udp.size(), cfg->outputs.iceoryx ? "on" : "off", more.c_str());
   return 0;
 }
 

@@ -20,6 +20,7 @@
 #include "hal/camera.h"
 #include "hal/sim_camera.h"
 #include "pipeline/pipeline.h"
+#include "pipeline/publish/output_registry.h"
 #include "track/frame_processor.h"
 
 namespace mocap::service {
@@ -31,6 +32,11 @@ struct CliOverrides {
   std::optional<int> loop_frames;  // --loop-frames (sim backend)
   bool no_realtime = false;        // --no-realtime
   bool no_iceoryx = false;         // --no-iceoryx
+  // Registry outputs from flags (--ros2 -> {"ros2", "true"}, --foxglove P -> {"foxglove",
+  // P}): replace or add to the configuration's outputs.NAME.
+  std::vector<std::pair<std::string, std::string>> outputs;
+  std::string multicast_if;  // --multicast-if (udp option)
+  int multicast_ttl = 1;     // --multicast-ttl (udp option)
 };
 
 // The configuration file (or the built-in defaults when `path` is empty) with the
@@ -40,6 +46,11 @@ Expected<config::RunConfig> resolve_run_config(const std::string& path, const Cl
 // `mocap run --check-config FILE`: prints "FILE: OK (...)" on stdout and returns 0, or
 // the one-line error on stderr and returns 1.
 int check_config_command(const std::string& path);
+
+// The output registry's requests (pipeline/publish/output_registry.h) of a resolved
+// configuration: udp, iceoryx, then outputs.* in file order (flags last).
+std::vector<publish::OutputRequest> output_requests(const config::RunConfig& cfg,
+                                                    const CliOverrides& cli);
 
 // pipeline::PipelineOptions from the configuration (stage table overrides included).
 pipeline::PipelineOptions pipeline_options(const config::RunConfig& cfg);

@@ -1,10 +1,11 @@
 // `mocap run [--udp HOST:PORT] [--multicast-if ADDR] [--multicast-ttl N] [--duration SECONDS]
 // [--stats FILE] [--stats-interval S] [--rate HZ] [--loop-frames N] [--no-realtime]
-// [--no-iceoryx]`: the live tracker (pipeline/). With no
+// [--no-iceoryx] [--ros2] [--foxglove [ADDR:]PORT]`: the live tracker (pipeline/). With no
 // configuration it runs on the simulated stereo pair of the built-in scenario (a
 // pre-rendered loop, hal/sim_camera.h) with the simulator's true joint model, and
 // publishes every frame over UDP (127.0.0.1:7755 by default) and iceoryx, through the
-// publishers of pipeline/publish when they are built in (MOCAP_HAVE_PUBLISH). --duration, SIGINT or
+// outputs of the registry (pipeline/publish/output_registry.h; --ros2, --foxglove).
+// --duration, SIGINT or
 // SIGTERM stop it cleanly (the signal handler only sets an atomic flag); it then prints the latency
 // statistics and, with --stats, writes them as JSON. While running, every --stats-interval
 // seconds one progress line goes to stderr (pipeline::format_progress_line); at the end a
@@ -14,7 +15,7 @@
 // --check-config FILE only validates one. Under systemd (NOTIFY_SOCKET) the supervisor of
 // pipeline/service sends READY, WATCHDOG (only while frames progress) and STATUS.
 // Structure: parse (RunArgs) -> service::resolve_run_config -> service::LiveSetup (cameras,
-// tracker, options) -> make_sinks -> Pipeline::create/start -> supervise (periodic report,
+// tracker, options) -> publish::create_outputs -> Pipeline::create/start -> supervise (periodic report,
 // sd_notify, stop conditions) -> report.
 #include <array>
 #include <atomic>
@@ -34,9 +35,7 @@
 #include "pipeline/service/notifier.h"
 #include "pipeline/service/supervisor.h"
 #include "pipeline/stats_report.h"
-#ifdef MOCAP_HAVE_PUBLISH
-#include "pipeline/publish/publishers.h"
-#endif
+#include "pipeline/publish/output_registry.h"
 
 namespace mocap::app {
 namespace {
@@ -71,19 +70,6 @@ bool is_roudi(int pid) {
 // with Restart=on-failure brings the tracker back, on UDP only while RouDi is away.
 constexpr int kExitRouDiShutdown = 75;
 
-#ifdef MOCAP_HAVE_PUBLISH
-// The UDP + iceoryx publishers of pipeline/publish as a pipeline sink.
-class PublishersSink final : public pipeline::JointsSink {
- public:
-  explicit PublishersSink(publish::Publishers p) : p_(std::move(p)) {}
-  bool publish(const client::JointsMessage& m) noexcept override { return p_.publish(m); }
-  const publish::Publishers& publishers() const noexcept { return p_; }
-
- private:
-  publish::Publishers p_;
-};
-#endif
-
 struct RunArgs {
   std::string udp = "127.0.0.1:7755";
   std::string multicast_if;  // --udp to a multicast group: local interface to send from
@@ -95,6 +81,8 @@ struct RunArgs {
   int loop_frames = 200;
   bool no_realtime = false;
   bool no_iceoryx = false;
+  bool ros2 = false;     // --ros2
+  std::string foxglove;  // --foxglove [ADDR:]PORT
   std::string config;        // --config FILE
   std::string check_config;  // --check-config FILE
   bool udp_given = false, rate_given = false, loop_frames_given = false;
@@ -112,42 +100,6 @@ Expected<std::pair<std::string, int>> parse_host_port(const std::string& s) {
   }
   if (port < 1 || port > 65535) return make_error("--udp", s, "port must be in 1..65535");
   return std::make_pair(s.substr(0, colon), port);
-}
-
-// The sinks of the pipeline: the UDP + iceoryx publishers when built in.
-struct Sinks {
-  std::vector<std::unique_ptr<pipeline::JointsSink>> owned;
-  std::vector<pipeline::JointsSink*> list() const {
-    std::vector<pipeline::JointsSink*> v;
-    for (const auto& s : owned) v.push_back(s.get());
-    return v;
-  }
-};
-
-Expected<Sinks> make_sinks(const config::OutputSettings& out,
-                           const std::pair<std::string, int>& udp, const RunArgs& a) {
-  Sinks sinks;
-#ifdef MOCAP_HAVE_PUBLISH
-  (void)udp;
-  publish::PublishersConfig pc;
-  pc.udp_destinations = out.udp;
-  pc.iceoryx = out.iceoryx;
-  pc.multicast.interface = a.multicast_if;  // used when a destination is a multicast group
-  pc.multicast.ttl = a.multicast_ttl;
-  auto pubs = publish::Publishers::create(pc);
-  if (!pubs) return pubs.error();
-  if (!pubs->notice().empty())
-    std::fprintf(stderr, "mocap run: note: %s\n", pubs->notice().c_str());
-  sinks.owned.push_back(std::make_unique<PublishersSink>(std::move(pubs).value()));
-#else
-  (void)out;
-  (void)a;
-  std::fprintf(stderr,
-               "mocap run: note: the publishers (pipeline/publish) are not built in: "
-               "joint angles for %s:%d are computed but not sent\n",
-               udp.first.c_str(), udp.second);
-#endif
-  return sinks;
 }
 
 void install_stop_handlers() {
@@ -215,6 +167,10 @@ int run_live(const RunArgs& a) {
   if (a.loop_frames_given) cli.loop_frames = a.loop_frames;
   cli.no_realtime = a.no_realtime;
   cli.no_iceoryx = a.no_iceoryx;
+  cli.multicast_if = a.multicast_if;
+  cli.multicast_ttl = a.multicast_ttl;
+  if (a.ros2) cli.outputs.emplace_back("ros2", "true");
+  if (!a.foxglove.empty()) cli.outputs.emplace_back("foxglove", a.foxglove);
   auto cfg = service::resolve_run_config(a.config, cli);
   if (!cfg) return fail(cfg.error().message);
   // Handlers first: a SIGTERM while the sim loop renders (seconds) must still stop cleanly.
@@ -224,15 +180,23 @@ int run_live(const RunArgs& a) {
   for (const std::string& n : (*live)->notices())
     std::fprintf(stderr, "mocap run: note: %s\n", n.c_str());
   const pipeline::PipelineOptions opt = (*live)->options();
-  auto sinks = make_sinks(cfg->outputs, *udp, a);
-  if (!sinks) return fail(sinks.error().message);
+  // Every output from the one registry (outputs: of the configuration + the flags).
+  FrameProcessor processor = (*live)->take_processor();
+  publish::OutputContext context;  // pointers used only while the outputs are created
+  context.targets = &processor.targets();
+  context.model = processor.has_model() ? &processor.model() : nullptr;
+  context.frame_rate_hz = opt.trigger_rate_hz;
+  auto outputs = publish::create_outputs(service::output_requests(*cfg, cli), context);
+  if (!outputs) return fail(outputs.error().message);
+  for (const std::string& n : outputs->notices)
+    std::fprintf(stderr, "mocap run: note: %s\n", n.c_str());
   // The service's view of the pipeline's health: one more sink at the end of the pipeline.
   service::HealthSink health;
-  std::vector<pipeline::JointsSink*> sink_list = sinks->list();
+  std::vector<publish::OutputSink*> sink_list = outputs->list();
   sink_list.push_back(&health);
 
   auto pipe =
-      pipeline::Pipeline::create((*live)->take_processor(), (*live)->cameras(), sink_list, opt);
+      pipeline::Pipeline::create(std::move(processor), (*live)->cameras(), sink_list, opt);
   if (!pipe) return fail(pipe.error().message);
 
   if (g_stop_requested.load(std::memory_order_relaxed)) {
@@ -300,6 +264,11 @@ void register_run(CLI::App& app, int& exit_code) {
       ->check(CLI::Range(2, 2000));
   cmd->add_flag("--no-realtime", args->no_realtime, "No CPU pinning and no SCHED_FIFO");
   cmd->add_flag("--no-iceoryx", args->no_iceoryx, "Do not publish over iceoryx shared memory");
+  cmd->add_flag("--ros2", args->ros2,
+                "Publish /joint_states and /tf over DDS as ROS 2 does (ROS_DOMAIN_ID; docs/ros2.md)");
+  cmd->add_option("--foxglove", args->foxglove,
+                  "Serve the Foxglove WebSocket live view on [ADDR:]PORT (default address "
+                  "127.0.0.1)");
   cmd->add_option("--config", args->config,
                   "Run the configuration FILE (cameras, rig, stages, outputs, thresholds; "
                   "docs/operations.md); flags given here override it");

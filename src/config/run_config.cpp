@@ -199,8 +199,34 @@ void read_pipeline(const YAML::Node& node, PipelineSettings& p) {
   }
 }
 
-void read_outputs(const YAML::Node& node, OutputSettings& o) {
-  const Section s(node, "outputs", {"udp", "iceoryx"});
+void read_outputs(const std::string& file, const YAML::Node& node, OutputSettings& o) {
+  // udp and iceoryx are read here; every other key is a registry output (OutputEntry),
+  // checked by pipeline/publish/output_registry (resolve_run_config, --check-config).
+  YAML::Node typed(YAML::NodeType::Map);
+  if (node.IsDefined() && node.IsMap()) {
+    formats_detail::check_unique_keys(node, "outputs");
+    for (const auto& kv : node) {
+      const std::string key = formats_detail::get_string(kv.first, "outputs");
+      if (key == "udp" || key == "iceoryx") {
+        typed[key] = kv.second;
+        continue;
+      }
+      OutputEntry e;
+      e.name = key;
+      e.where = file + ": outputs." + key + line_suffix(kv.second);
+      if (kv.second.IsSequence()) {
+        for (std::size_t i = 0; i < kv.second.size(); ++i)
+          e.values.push_back(formats_detail::get_string(kv.second[i], index_path("outputs." + key, i)));
+      } else if (kv.second.IsScalar()) {
+        e.values.push_back(formats_detail::get_string(kv.second, "outputs." + key));
+      } else {
+        fail("outputs." + key, "expected a value or a list of values, got " +
+                                   formats_detail::describe(kv.second) + line_suffix(kv.second));
+      }
+      o.more.push_back(std::move(e));
+    }
+  }
+  const Section s(node.IsDefined() && node.IsMap() ? typed : node, "outputs", {"udp", "iceoryx"});
   if (s.has("udp")) {
     const YAML::Node list = s.node("udp");
     o.udp.clear();
@@ -308,7 +334,7 @@ Expected<RunConfig> parse(const std::string& path, const YAML::Node& root) {
   if (const auto v = top.text("targets")) cfg.targets_path = resolve(base, *v);
   if (const auto v = top.text("model")) cfg.model_path = resolve(base, *v);
   read_pipeline(top.node("pipeline"), cfg.pipeline);
-  read_outputs(top.node("outputs"), cfg.outputs);
+  read_outputs(path, top.node("outputs"), cfg.outputs);
   read_detection(top.node("detection"), cfg.tracker.detect);
   read_stereo(top.node("stereo"), cfg.tracker.stereo);
   read_identification(top.node("identification"), cfg.tracker.identify);

@@ -65,9 +65,19 @@ struct PipelineSettings {
   std::array<StageSettings, kStageCount> stages{};
 };
 
+// A further output of the `outputs:` map (ros2, foxglove, ... : any key other than udp
+// and iceoryx), kept as text here and validated by the output registry
+// (pipeline/publish/output_registry.h), which is built after this module.
+struct OutputEntry {
+  std::string name;                 // the key: the registry's output name
+  std::vector<std::string> values;  // a scalar: one value; a list: one per item
+  std::string where;                // "FILE: outputs.NAME (line N)" for error messages
+};
+
 struct OutputSettings {
   std::vector<std::string> udp = {"127.0.0.1:7755"};  // "HOST:PORT" each, may be empty
   bool iceoryx = true;
+  std::vector<OutputEntry> more;  // in file order
 };
 
 struct SimSettings {

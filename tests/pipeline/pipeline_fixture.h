@@ -76,11 +76,14 @@ struct SimRigFixture {
 };
 
 // Stores up to `capacity` messages; optional sleep per publish (a slow transport).
-class RecordingSink final : public JointsSink {
+class RecordingSink final : public publish::OutputSink {
  public:
   explicit RecordingSink(std::size_t capacity, int sleep_us = 0)
       : messages_(capacity), sleep_us_(sleep_us) {}
-  bool publish(const client::JointsMessage& m) noexcept override {
+  const char* name() const noexcept override { return "recording"; }
+  publish::OutputCounters counters() const noexcept override { return {}; }
+  bool publish(const publish::FrameResult& frame) noexcept override {
+    const client::JointsMessage& m = frame.joints;
     if (sleep_us_ > 0) std::this_thread::sleep_for(std::chrono::microseconds(sleep_us_));
     const std::size_t n = count_.load(std::memory_order_relaxed);  // single writer
     if (n >= messages_.size()) return false;

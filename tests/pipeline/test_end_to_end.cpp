@@ -33,18 +33,22 @@ using test::shared_loop;
 using test::SimRigFixture;
 
 // Stalls the publish thread on every 25th frame (a slow consumer of the pipeline).
-class StallingSink final : public JointsSink {
+class StallingSink final : public publish::OutputSink {
  public:
-  bool publish(const client::JointsMessage& m) noexcept override {
-    if (m.sequence % 25 == 10) std::this_thread::sleep_for(std::chrono::milliseconds(30));
+  const char* name() const noexcept override { return "stalling"; }
+  publish::OutputCounters counters() const noexcept override { return {}; }
+  bool publish(const publish::FrameResult& f) noexcept override {
+    if (f.joints.sequence % 25 == 10) std::this_thread::sleep_for(std::chrono::milliseconds(30));
     return true;
   }
 };
 
-class UdpSink final : public JointsSink {
+class UdpSink final : public publish::OutputSink {
  public:
   explicit UdpSink(publish::UdpPublisher p) : p_(std::move(p)) {}
-  bool publish(const client::JointsMessage& m) noexcept override { return p_.publish(m); }
+  const char* name() const noexcept override { return "udp"; }
+  publish::OutputCounters counters() const noexcept override { return {}; }
+  bool publish(const publish::FrameResult& f) noexcept override { return p_.publish(f.joints); }
 
  private:
   publish::UdpPublisher p_;

@@ -77,10 +77,12 @@ class WrappedCamera final : public hal::Camera {
   std::uint64_t delivered_ = 0;
 };
 
-class UdpSink final : public JointsSink {
+class UdpSink final : public publish::OutputSink {
  public:
   explicit UdpSink(publish::UdpPublisher p) : p_(std::move(p)) {}
-  bool publish(const client::JointsMessage& m) noexcept override { return p_.publish(m); }
+  const char* name() const noexcept override { return "udp"; }
+  publish::OutputCounters counters() const noexcept override { return {}; }
+  bool publish(const publish::FrameResult& f) noexcept override { return p_.publish(f.joints); }
   const publish::UdpPublisher& publisher() const { return p_; }
 
  private:

@@ -1,7 +1,7 @@
 // Design: shared-memory round trip with a real iceoryx daemon. The suite starts
 // `iox-roudi -m off -c <small config>` as a child process once (iceoryx allows one
 // runtime per process, so every test here shares it), publishes JointsMessage through
-// IceoryxPublisher / Publishers and takes it with IceoryxSubscriber. Each test body runs
+// IceoryxPublisher / the registry's iceoryx sink and takes it with IceoryxSubscriber. Each test body runs
 // in a forked child with its own iceoryx runtime that exits before RouDi stops: RouDi
 // sends SIGTERM to every still-registered process when it shuts down. Skipped, with the
 // reason, when iox-roudi is not installed or another RouDi already runs on the machine.
@@ -19,7 +19,7 @@
 #include "client/iceoryx_subscriber.h"
 #include "client/roudi_probe.h"
 #include "pipeline/publish/iceoryx_publisher.h"
-#include "pipeline/publish/publishers.h"
+#include "pipeline/publish/output_registry.h"
 #include "tests/support/alloc_counter.h"
 #include "tests/support/test_support.h"
 
@@ -182,29 +182,34 @@ TEST_F(IceoryxRoundTrip, PublishSubscribeCountsGapsAndAllocatesNothing) {
   run_in_child(publish_subscribe_body);
 }
 
-void aggregate_body() {
-  mocap::publish::PublishersConfig cfg;
-  cfg.iceoryx_app_name = app_name();
-  auto pubs = mocap::publish::Publishers::create(cfg);
-  ASSERT_TRUE(pubs.ok()) << pubs.error().message;
-  EXPECT_TRUE(pubs->iceoryx_active());
-  EXPECT_TRUE(pubs->notice().empty());
+void registry_body() {
+  std::vector<mocap::publish::OutputRequest> req = {
+      {"iceoryx", {"true"}, "test: outputs.iceoryx", {{"app_name", app_name()}}}};
+  auto outs = mocap::publish::create_outputs(req, {});
+  ASSERT_TRUE(outs.ok()) << outs.error().message;
+  ASSERT_EQ(outs->sinks.size(), 1u);
+  EXPECT_TRUE(outs->notices.empty());
   auto sub = mocap::client::IceoryxSubscriber::create(app_name());
   ASSERT_TRUE(sub.ok());
   auto& s = *sub.value();
-  for (int i = 0; i < 200 && !(s.subscribed() && pubs->iceoryx()->has_subscribers()); ++i) {
+  for (int i = 0; i < 200 && !s.subscribed(); ++i) {
     std::this_thread::sleep_for(std::chrono::milliseconds(25));
   }
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));  // publisher side sees it too
   ASSERT_TRUE(s.subscribed());
+  auto frame = std::make_unique<mocap::publish::FrameResult>();
+  frame->joints = make_message(41);
+  frame->joints.publish_ns = 777;
+  ASSERT_TRUE(outs->sinks[0]->publish(*frame));
   JointsMessage out;
-  ASSERT_TRUE(pubs->publish(make_message(41)));
   ASSERT_TRUE(s.take_latest(out));
   EXPECT_EQ(out.sequence, 41u);
-  EXPECT_GT(out.publish_ns, 0);  // stamped by the aggregate
+  EXPECT_EQ(out.publish_ns, 777);  // stamped by the publish stage, sent unchanged
+  EXPECT_EQ(outs->sinks[0]->counters().published, 1u);
 }
 
-TEST_F(IceoryxRoundTrip, PublishersAggregateUsesSharedMemoryWhenRouDiRuns) {
-  run_in_child(aggregate_body);
+TEST_F(IceoryxRoundTrip, RegistryIceoryxSinkUsesSharedMemoryWhenRouDiRuns) {
+  run_in_child(registry_body);
 }
 
 TEST(IceoryxNoRouDi, FailsFastAtAPathNobodyBinds) {

@@ -67,6 +67,46 @@ TEST(LiveSetup, CommandLineOverridesTheFile) {
   EXPECT_NE(missing.error().message.find("absent.yaml: cannot open"), std::string::npos);
 }
 
+TEST(LiveSetup, RegistryOutputsFromTheFileAndTheFlags) {
+  test::TempDir dir("svc_outputs");
+  test::write_file(dir.file("o.yaml"),
+                   "outputs:\n  udp: []\n  iceoryx: false\n  ros2: false\n");
+  auto cfg = resolve_run_config(dir.file("o.yaml"), CliOverrides{});
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  ASSERT_EQ(cfg->outputs.more.size(), 1u);
+  EXPECT_EQ(cfg->outputs.more[0].name, "ros2");
+  EXPECT_EQ(cfg->outputs.more[0].values, std::vector<std::string>{"false"});
+  CliOverrides cli;
+  cli.outputs.emplace_back("ros2", "true");  // --ros2 replaces outputs.ros2
+  auto on = resolve_run_config(dir.file("o.yaml"), cli);
+  ASSERT_TRUE(on) << on.error().message;
+  ASSERT_EQ(on->outputs.more.size(), 1u);
+  EXPECT_EQ(on->outputs.more[0].values, std::vector<std::string>{"true"});
+  const auto req = output_requests(*on, cli);
+  ASSERT_EQ(req.size(), 3u);  // udp, iceoryx, ros2
+  EXPECT_EQ(req[0].name, "udp");
+  EXPECT_TRUE(req[0].values.empty());
+  EXPECT_EQ(req[2].name, "ros2");
+  EXPECT_EQ(req[2].where, "--ros2");
+
+  test::write_file(dir.file("bad.yaml"), "outputs:\n  udp: []\n  nosuch: 1\n");
+  auto bad = resolve_run_config(dir.file("bad.yaml"), CliOverrides{});
+  ASSERT_FALSE(bad);
+  EXPECT_EQ(bad.error().message.rfind(dir.file("bad.yaml") +
+                                          ": outputs.nosuch (line 3): unknown output 'nosuch' "
+                                          "(known: udp, iceoryx",
+                                      0),
+            0u)
+      << bad.error().message;
+  EXPECT_EQ(check_config_command(dir.file("bad.yaml")), 1);
+  test::write_file(dir.file("map.yaml"), "outputs:\n  ros2: {a: 1}\n");
+  auto map = resolve_run_config(dir.file("map.yaml"), CliOverrides{});
+  ASSERT_FALSE(map);
+  EXPECT_NE(map.error().message.find("outputs.ros2: expected a value or a list of values"),
+            std::string::npos)
+      << map.error().message;
+}
+
 TEST(LiveSetup, ReplayCamerasConfiguredFromTheFile) {
   test::TempDir dir("svc_setup");
   test::write_tiny_recording(dir.file("rec"), 4);

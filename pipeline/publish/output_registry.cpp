@@ -1,0 +1,78 @@
+// Design: see output_registry.h. The table below is the only list of outputs.
+#include "pipeline/publish/output_registry.h"
+
+#include <algorithm>
+#include <cctype>
+
+namespace mocap::publish {
+
+// One declaration + one table line per output (each defined in its own file).
+extern const OutputKind kUdpOutput;      // udp_sink.cpp
+extern const OutputKind kIceoryxOutput;  // iceoryx_sink.cpp
+#ifdef MOCAP_HAVE_ROS2
+extern const OutputKind kRos2Output;  // ros2/ros2_sink.cpp
+#endif
+#ifdef MOCAP_HAVE_FOXGLOVE
+extern const OutputKind kFoxgloveOutput;  // foxglove (branch foxglove)
+#endif
+
+const std::vector<OutputKind>& output_kinds() {
+  static const std::vector<OutputKind> kinds = {
+      kUdpOutput,
+      kIceoryxOutput,
+#ifdef MOCAP_HAVE_ROS2
+      kRos2Output,
+#endif
+#ifdef MOCAP_HAVE_FOXGLOVE
+      kFoxgloveOutput,
+#endif
+  };
+  return kinds;
+}
+
+const OutputKind* find_output_kind(const std::string& name) noexcept {
+  for (const OutputKind& k : output_kinds())
+    if (name == k.name) return &k;
+  return nullptr;
+}
+
+Expected<bool> request_flag(const OutputRequest& r) {
+  if (r.values.size() != 1)
+    return make_error(r.where, "",
+                      "expected true or false, got " + std::to_string(r.values.size()) + " values");
+  std::string v = r.values[0];
+  std::transform(v.begin(), v.end(), v.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (v == "true" || v == "yes" || v == "on" || v == "1") return true;
+  if (v == "false" || v == "no" || v == "off" || v == "0") return false;
+  return make_error(r.where, "", "expected true or false, got '" + r.values[0] + "'");
+}
+
+Expected<void> check_outputs(const std::vector<OutputRequest>& requests) {
+  for (const OutputRequest& r : requests) {
+    const OutputKind* k = find_output_kind(r.name);
+    if (k == nullptr) {
+      std::string known;
+      for (const OutputKind& kind : output_kinds())
+        known += (known.empty() ? "" : ", ") + std::string(kind.name);
+      return make_error(r.where, "", "unknown output '" + r.name + "' (known: " + known + ")");
+    }
+    if (auto c = k->check(r); !c) return c.error();
+  }
+  return {};
+}
+
+Expected<Outputs> create_outputs(const std::vector<OutputRequest>& requests,
+                                 const OutputContext& context) {
+  if (auto c = check_outputs(requests); !c) return c.error();
+  Outputs out;
+  for (const OutputRequest& r : requests) {
+    auto created = find_output_kind(r.name)->create(r, context);
+    if (!created) return created.error();
+    if (!created->notice.empty()) out.notices.push_back(created->notice);
+    if (created->sink) out.sinks.push_back(std::move(created->sink));
+  }
+  return out;
+}
+
+}  // namespace mocap::publish

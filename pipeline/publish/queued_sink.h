@@ -1,0 +1,74 @@
+// Design: the base of every slow output (DDS, JSON over WebSocket, files): publish() on
+// the real-time publish thread only copies the frame result into a bounded drop-oldest
+// queue (rt::DropOldestQueue, `depth` waiting frames) and returns; a worker thread of
+// its own (non-real-time, started at setup) takes the frames oldest first and calls the
+// derived class's encode(), which may allocate, lock, log and block. When the worker
+// falls behind, the oldest waiting frame is dropped and counted (`dropped`), so a
+// stalled transport never stalls the tracker and the newest data always gets in.
+// Exceptions from encode()/idle() are caught on the worker and counted as failures.
+//
+// Wake-up: the worker sleeps on a Doorbell (futex) with a 100 ms timeout, after which it
+// calls idle() (accept connections, re-announce, ...). publish() rings the doorbell: one
+// atomic increment plus, only when the worker is actually asleep, one FUTEX_WAKE
+// syscall. At 100 fps the worker usually sleeps between frames, so that wake costs about
+// one short syscall per frame on the publish thread; the alternative, a polling worker,
+// would instead add up to its polling period of latency to every output frame and burn
+// CPU on the dual-core capture PC, so the wake is the chosen cost (measured in
+// docs/performance.md). When the worker is busy (a backlog) no syscall is made.
+//
+// Lifetime: derived classes MUST call stop() in their own destructor (the base
+// destructor also calls it, but by then the derived part is gone while the worker might
+// still be inside encode()). start() and stop() are setup/teardown calls of the owner.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <thread>
+
+#include "core/expected.h"
+#include "hal/rt/counter.h"
+#include "hal/rt/drop_oldest_queue.h"
+#include "pipeline/doorbell.h"
+#include "pipeline/publish/output_sink.h"
+
+namespace mocap::publish {
+
+class QueuedSink : public OutputSink {
+ public:
+  // Preallocates `depth` waiting FrameResult slots (plus the producer's and the worker's
+  // working copies); depth is clamped to [1, 1024].
+  explicit QueuedSink(int depth);
+  ~QueuedSink() override;
+
+  // Starts the worker thread (setup). Error: the thread could not be created.
+  Expected<void> start();
+  // Wakes and joins the worker (frames still waiting are not encoded). Idempotent.
+  void stop() noexcept;
+
+  // Publish thread: copy in; when `depth` frames are waiting, drop the oldest (counted).
+  // Always true: the frame was accepted (a drop is not a failure of this frame).
+  bool publish(const FrameResult& frame) noexcept final;
+  OutputCounters counters() const noexcept override;
+
+  // Frames waiting (a hint, any thread).
+  std::size_t queued_approx() const noexcept { return queue_->size_approx(); }
+
+ protected:
+  // Worker thread: encode and send one frame; may allocate; an exception is a failure.
+  virtual void encode(const FrameResult& frame) = 0;
+  // Worker thread: called about every 100 ms while no frame is waiting.
+  virtual void idle() {}
+
+ private:
+  void worker_loop() noexcept;
+
+  std::unique_ptr<rt::DropOldestQueue<FrameResult>> queue_;
+  pipeline::Doorbell bell_;
+  std::atomic<bool> stop_{false};
+  std::thread worker_;
+  rt::Counter published_;  // worker: encode() returned
+  rt::Counter failures_;   // worker: encode() threw
+};
+
+}  // namespace mocap::publish
