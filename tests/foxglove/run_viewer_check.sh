@@ -14,11 +14,11 @@ trap 'rm -rf "$work"' EXIT
 free_port() { python3 -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])'; }
 port=$(free_port)
 udp=$(free_port)
-duration=8
-"$mocap" run --foxglove "127.0.0.1:$port" --duration "$duration" --rate 100 --no-iceoryx --no-realtime \
+duration=6
+"$mocap" run --foxglove "127.0.0.1:$port" --duration "$duration" --rate 100 --loop-frames 20 --no-iceoryx --no-realtime \
   --udp "127.0.0.1:$udp" --stats "$work/stats.json" >"$work/run.log" 2>&1 &
 pid=$!
-for _ in $(seq 1 100); do
+for _ in $(seq 1 600); do
   if (exec 3<>"/dev/tcp/127.0.0.1/$port") 2>/dev/null; then break; fi
   if ! kill -0 "$pid" 2>/dev/null; then echo "FAIL mocap run exited early:"; cat "$work/run.log"; exit 1; fi
   sleep 0.1

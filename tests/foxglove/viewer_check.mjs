@@ -8,10 +8,13 @@
 // frames; the checks above must still pass. Exit status 0 = pass; failures print one
 // line each.
 //   node viewer_check.mjs URL SECONDS MIN_HZ [--hostile]
-import { FoxgloveClient } from "@foxglove/ws-protocol";
-import * as schemas from "@foxglove/schemas/jsonschema";
-import Ajv from "ajv";
+import { createRequire } from "node:module";
 import WebSocket from "ws";
+
+const require = createRequire(import.meta.url);  // CommonJS-only packages
+const { FoxgloveClient } = require("@foxglove/ws-protocol");
+const schemas = require("@foxglove/schemas/jsonschema");
+const Ajv = require("ajv");
 
 const [url, secondsArg, minHzArg, mode] = process.argv.slice(2);
 const seconds = Number(secondsArg ?? 3);
@@ -43,7 +46,7 @@ function hostile() {
   });
   stalled.on("error", () => {});
   sockets.push(stalled);
-  // Floods of malformed frames, one new connection every 20 ms.
+  // Floods of malformed frames, one new connection every 50 ms.
   const junk = ["{", "[]", '{"op":"nope"}', '{"op":"subscribe","subscriptions":[{"id":1,"channelId":999}]}',
                 Buffer.from([1, 2, 3, 4]), "x".repeat(70000)];
   let n = 0;
@@ -53,7 +56,7 @@ function hostile() {
     ws.on("open", () => { for (let i = 0; i < 5; ++i) ws.send(payload); });
     ws.on("error", () => {});
     ws.on("close", () => {});
-  }, 20);
+  }, 50);
   return () => { clearInterval(timer); for (const s of sockets) s.terminate(); };
 }
 
