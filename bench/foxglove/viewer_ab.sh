@@ -16,19 +16,29 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 free_port() { python3 -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])'; }
 p99() {
-  python3 -c 'import json,sys; s=json.load(open(sys.argv[1])); p=s["stages"]["publish"]; print(f"{p[\"p50_us\"]:.1f} {p[\"p99_us\"]:.1f} {s[\"published\"]} {s[\"triggered\"]}")' "$1"
+  python3 - "$1" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+p = s["stages"]["publish"]
+w = s["stages"].get("sink_work", {"p50_us": float("nan"), "p99_us": float("nan")})
+c = s.get("counters", {})
+fox = "/".join(str(c.get(k, "-")) for k in ("output_foxglove_published", "output_foxglove_dropped"))
+print(f'{s["published"]}/{s["triggered"]} p50 {p["p50_us"]:.0f} p99 {p["p99_us"]:.0f} '
+      f'p99.9 {p["p999_us"]:.0f} max {p["max_us"]:.0f} sink_work p50 {w["p50_us"]:.0f} '
+      f'p99 {w["p99_us"]:.0f} foxglove published/dropped {fox}')
+PY
 }
 for i in $(seq 1 "$pairs"); do
   udp=$(free_port)
-  "$mocap" run --rate 100 --duration "$duration" --no-iceoryx --udp "127.0.0.1:$udp" \
+  "$mocap" run --rate 100 --loop-frames 50 --duration "$duration" --no-iceoryx --stats-interval 0 --udp "127.0.0.1:$udp" \
     --stats "$work/a.json" >"$work/a.log" 2>&1
-  echo "A $i (no live view):        p50/p99 us, published, triggered: $(p99 "$work/a.json")"
+  echo "A-$i: $(p99 "$work/a.json")"
   port=$(free_port)
-  "$mocap" run --rate 100 --duration "$duration" --no-iceoryx --udp "127.0.0.1:$udp" \
+  "$mocap" run --rate 100 --loop-frames 50 --duration "$duration" --no-iceoryx --stats-interval 0 --udp "127.0.0.1:$udp" \
     --foxglove "127.0.0.1:$port" "${extra_b[@]}" --stats "$work/b.json" >"$work/b.log" 2>&1 &
   pid=$!
   for _ in $(seq 1 100); do (exec 3<>"/dev/tcp/127.0.0.1/$port") 2>/dev/null && break; sleep 0.1; done
   node "$npm_dir/viewer_check.mjs" "ws://127.0.0.1:$port" $((duration - 3)) 30 >"$work/viewer.log" 2>&1 || true
   wait "$pid"
-  echo "B $i (foxglove + 1 viewer): p50/p99 us, published, triggered: $(p99 "$work/b.json")  viewer: $(tr '\n' ' ' <"$work/viewer.log")"
+  echo "B-$i: $(p99 "$work/b.json")  viewer: $(tr '\n' ' ' <"$work/viewer.log")"
 done
