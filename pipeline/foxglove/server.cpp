@@ -133,8 +133,22 @@ int Server::Impl::channel_index(std::uint32_t channel_id) const noexcept {
 void Server::Impl::accept_next() {
   acceptor.async_accept([this](boost::system::error_code ec, tcp::socket socket) {
     if (ec == asio::error::operation_aborted) return;
-    if (!ec) std::make_shared<Session>(*this, std::move(socket))->start();
-    accept_next();  // transient errors (EMFILE, ECONNABORTED) never stop the server
+    if (ec) {  // EMFILE, ENFILE, ...: retry later instead of spinning; never stop serving
+      accept_retry.expires_after(std::chrono::milliseconds(100));
+      accept_retry.async_wait([this](boost::system::error_code e) {
+        if (!e) accept_next();
+      });
+      return;
+    }
+    if (pending_handshakes >= kMaxPendingHandshakes) {
+      // Many half-open connections (a scan or a flood): drop this one unanswered.
+      counters.clients_refused.fetch_add(1, std::memory_order_relaxed);
+      boost::system::error_code ignored;
+      socket.close(ignored);
+    } else {
+      std::make_shared<Session>(*this, std::move(socket))->start();
+    }
+    accept_next();
   });
 }
 

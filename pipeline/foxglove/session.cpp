@@ -50,6 +50,8 @@ Session::Session(Server::Impl& server, asio::ip::tcp::socket socket)
 }
 
 void Session::start() {
+  pending_ = true;
+  ++server_.pending_handshakes;
   handshake_timer_.expires_after(std::chrono::milliseconds(server_.options.handshake_ms));
   handshake_timer_.async_wait([self = shared_from_this()](error_code ec) {
     if (!ec && !self->open_) self->finish("handshake timeout");
@@ -62,7 +64,14 @@ void Session::start() {
       [self = shared_from_this()](error_code ec, std::size_t) { self->on_request(ec); });
 }
 
+void Session::leave_pending() noexcept {
+  if (!pending_) return;
+  pending_ = false;
+  --server_.pending_handshakes;
+}
+
 void Session::on_request(error_code ec) {
+  leave_pending();
   if (ec) return finish("bad HTTP request: " + ec.message());
   const auto& req = parser_->get();
   if (!websocket::is_upgrade(req)) {
@@ -218,6 +227,7 @@ void Session::check_stall(std::chrono::steady_clock::time_point now) {
 void Session::finish(const std::string& reason) {
   if (done_) return;
   done_ = true;
+  leave_pending();
   handshake_timer_.cancel();
   error_code ec;
   ws_.next_layer().shutdown(asio::ip::tcp::socket::shutdown_both, ec);

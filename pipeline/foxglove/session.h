@@ -28,6 +28,7 @@
 namespace mocap::foxglove {
 
 inline constexpr std::size_t kMaxChannels = 8;
+inline constexpr int kMaxPendingHandshakes = 16;  // connections still in their HTTP request
 
 class Session;
 
@@ -42,6 +43,8 @@ struct Server::Impl {
   boost::asio::steady_timer tick_timer{ioc};
   std::thread thread;
   std::vector<std::shared_ptr<Session>> sessions;  // open WebSocket sessions (io thread)
+  int pending_handshakes = 0;                      // sessions before their HTTP request (io)
+  boost::asio::steady_timer accept_retry{ioc};     // after an accept error (EMFILE, ...)
   std::array<std::atomic<int>, kMaxChannels> subscribers{};
   struct {
     std::atomic<std::uint64_t> clients_accepted{0}, clients_refused{0}, protocol_errors{0},
@@ -82,6 +85,7 @@ class Session : public std::enable_shared_from_this<Session> {
   void enqueue(Outgoing message);
   void pump();
   void finish(const std::string& reason);
+  void leave_pending() noexcept;
 
   Server::Impl& server_;
   boost::beast::websocket::stream<boost::asio::ip::tcp::socket> ws_;
@@ -97,6 +101,7 @@ class Session : public std::enable_shared_from_this<Session> {
   bool open_ = false;     // WebSocket established and registered with the server
   bool closing_ = false;  // violation: drain, then close
   bool done_ = false;
+  bool pending_ = false;  // counted in Server::Impl::pending_handshakes
   std::string close_reason_;
   std::chrono::steady_clock::time_point write_started_{};
   std::uint64_t sent_ = 0;

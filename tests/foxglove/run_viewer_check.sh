@@ -3,7 +3,7 @@
 # reference-client check (viewer_check.mjs, @foxglove/ws-protocol) against it; in
 # --hostile mode a viewer that never reads and floods of malformed frames run at the same
 # time. Passes when the client's checks pass, `mocap run` exits 0, and the tracker kept
-# its frame rate (published >= 90 % of the frames of the run at its 100 Hz trigger).
+# its frame rate (>= 80 % of the 100 Hz triggers happened, >= 90 % of them published).
 #   run_viewer_check.sh MOCAP NPM_DIR [--hostile]
 set -euo pipefail
 mocap=$1
@@ -33,9 +33,9 @@ fi
 python3 - "$work/stats.json" <<'PY' || status=1
 import json, sys
 s = json.load(open(sys.argv[1]))
-fps, published, duration = s["fps"], s["published"], s["duration_s"]
-print(f"mocap run: {published} frames published in {duration:.1f} s at {fps:.1f} fps")
-if published < 0.9 * 100 * duration:
+fps, published, triggered, duration = s["fps"], s["published"], s["triggered"], s["duration_s"]
+print(f"mocap run: {published} of {triggered} frames published in {duration:.1f} s at {fps:.1f} fps")
+if published < 0.9 * triggered or triggered < 0.8 * 100 * duration:
     print(f"FAIL the tracker did not keep its frame rate ({published} published, {fps} fps)")
     sys.exit(1)
 PY

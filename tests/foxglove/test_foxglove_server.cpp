@@ -121,6 +121,27 @@ TEST(FoxgloveServer, RefusesPlainHttpWrongSubprotocolAndTooManyViewers) {
   EXPECT_TRUE(d.connect(server->port())) << d.error;
 }
 
+TEST(FoxgloveServer, IdleConnectionsAreBoundedAndTimedOut) {
+  ServerOptions o;
+  o.handshake_ms = 300;
+  auto server = start_server(o);
+  ASSERT_TRUE(server);
+  test::asio::io_context ioc;
+  std::vector<test::tcp::socket> idle;
+  for (int i = 0; i < 20; ++i) {  // connect and never send the HTTP request
+    idle.emplace_back(ioc);
+    idle.back().connect(
+        test::tcp::endpoint(test::asio::ip::make_address("127.0.0.1"), server->port()));
+  }
+  ASSERT_TRUE(eventually([&] { return server->counters().clients_refused >= 4; }));
+  // The handshake deadline closes the idle ones; then viewers get in again.
+  ASSERT_TRUE(eventually([&] {
+    WsClient c;
+    return c.connect(server->port());
+  }));
+  EXPECT_EQ(server->counters().clients_accepted, 1u);
+}
+
 TEST(FoxgloveServer, HostileInputEndsOnlyThatConnection) {
   ServerOptions o;
   o.max_message_bytes = 4096;
