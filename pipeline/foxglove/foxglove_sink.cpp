@@ -124,7 +124,11 @@ Expected<OutputCreated> create_foxglove(const OutputRequest& r, const OutputCont
   auto scene = foxglove::make_scene(*ctx.targets, ctx.model);
   if (!scene) return scene.error();
   auto server = foxglove::Server::create(*o, foxglove::live_view_channels());
-  if (!server) return make_error(r.where, "", server.error().message);
+  if (!server) {  // "foxglove: ADDR:PORT: cannot listen: ..." -> under the request's name
+    std::string m = server.error().message;
+    if (m.rfind("foxglove: ", 0) == 0) m.erase(0, 10);
+    return make_error(r.where, "", m);
+  }
   const std::string host =
       o->address.find(':') != std::string::npos ? "[" + o->address + "]" : o->address;
   const std::string url = "ws://" + host + ":" + std::to_string((*server)->port());
