@@ -1,0 +1,40 @@
+// Design: the encoders of the live view's channels, from one frame's result
+// (publish::FrameResult) and the immutable scene (scene.h) to the JSON text of one
+// message. They run on the Foxglove sink's worker thread, never on the real-time
+// threads, and may allocate. Units and frames: FrameResult is in millimetres in the
+// world frame; Foxglove uses metres, so every position is divided by 1000 and every
+// body pose becomes a transform world_frame ("mocap") -> body name.
+//   /tf       foxglove.FrameTransforms: one transform per body found in the frame.
+//   /markers  foxglove.SceneUpdate: entity "points" (every triangulated point, small grey
+//             spheres), "markers" (labelled markers, spheres coloured by body), "bodies"
+//             (body name labels), "joints" (joint centres as spheres, hinge axes as
+//             arrows, of joints whose parent body was found).
+//   /joints   mocap.JointAngles: name, type, valid, angles (rad), solved_by, sd (rad).
+// Timestamps: stamp_ns is the capture time on the wall clock (CLOCK_REALTIME, ns).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "pipeline/foxglove/protocol.h"
+#include "pipeline/foxglove/scene.h"
+#include "pipeline/publish/frame_result.h"
+
+namespace mocap::foxglove {
+
+inline constexpr std::uint32_t kChannelTf = 1;
+inline constexpr std::uint32_t kChannelMarkers = 2;
+inline constexpr std::uint32_t kChannelJoints = 3;
+
+// The advertised channels, ids as above.
+std::vector<ChannelInfo> live_view_channels();
+
+std::string encode_frame_transforms(const FoxgloveScene& scene, const publish::FrameResult& frame,
+                                    std::int64_t stamp_ns);
+std::string encode_scene_update(const FoxgloveScene& scene, const publish::FrameResult& frame,
+                                std::int64_t stamp_ns);
+std::string encode_joint_angles(const FoxgloveScene& scene, const publish::FrameResult& frame,
+                                std::int64_t stamp_ns);
+
+}  // namespace mocap::foxglove

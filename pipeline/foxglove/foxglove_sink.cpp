@@ -1,0 +1,151 @@
+// Design: the Foxglove live view as an output of the seam (pipeline/publish): a
+// QueuedSink, so the real-time publish thread only copies the frame result into a
+// bounded drop-oldest queue; this sink's worker thread encodes the JSON messages of the
+// channels some viewer subscribes to (encode.h; none when nobody watches) and hands
+// them to the server (server.h), whose own io thread writes them to each viewer's
+// bounded queue. Registered as output "foxglove" (`--foxglove [ADDR:]PORT`,
+// `outputs: foxglove: "[ADDR:]PORT"`); options max_clients and client_queue.
+// Timestamps: capture time moved from CLOCK_MONOTONIC to the wall clock (offset taken
+// at setup), since the Foxglove app shows and orders messages by wall-clock time.
+// counters().dropped = frames dropped by the sink's queue + messages dropped by viewers'
+// queues (both are "the viewer did not get this", see docs/foxglove.md).
+#include <time.h>
+
+#include <memory>
+#include <string>
+
+#include "pipeline/foxglove/encode.h"
+#include "pipeline/foxglove/server.h"
+#include "pipeline/publish/output_registry.h"
+#include "pipeline/publish/queued_sink.h"
+
+namespace mocap::publish {
+
+namespace {
+
+constexpr int kFrameQueueDepth = 4;  // frames waiting for the encoder: the newest matter
+
+std::int64_t clock_ns(clockid_t id) {
+  timespec ts{};
+  clock_gettime(id, &ts);
+  return std::int64_t{ts.tv_sec} * 1000000000 + ts.tv_nsec;
+}
+
+class FoxgloveSink final : public QueuedSink {
+ public:
+  FoxgloveSink(foxglove::FoxgloveScene scene, std::unique_ptr<foxglove::Server> server,
+               std::string url)
+      : QueuedSink(kFrameQueueDepth),
+        scene_(std::move(scene)),
+        server_(std::move(server)),
+        url_(std::move(url)),
+        realtime_minus_monotonic_ns_(clock_ns(CLOCK_REALTIME) - clock_ns(CLOCK_MONOTONIC)) {}
+  ~FoxgloveSink() override {
+    stop();  // the worker first (it calls the server), then the server
+    server_->stop();
+  }
+
+  const char* name() const noexcept override { return "foxglove"; }
+  std::string notice() const override { return "foxglove: live view on " + url_; }
+  OutputCounters counters() const noexcept override {
+    OutputCounters c = QueuedSink::counters();
+    c.dropped += server_->counters().messages_dropped;
+    return c;
+  }
+
+ protected:
+  void encode(const FrameResult& frame) override {
+    const std::int64_t stamp_ns = frame.joints.capture_ns + realtime_minus_monotonic_ns_;
+    const auto ts = static_cast<std::uint64_t>(stamp_ns > 0 ? stamp_ns : 0);
+    using foxglove::kChannelJoints, foxglove::kChannelMarkers, foxglove::kChannelTf;
+    if (server_->has_subscribers(kChannelTf)) {
+      server_->broadcast(kChannelTf, ts,
+                         std::make_shared<const std::string>(
+                             foxglove::encode_frame_transforms(scene_, frame, stamp_ns)));
+    }
+    if (server_->has_subscribers(kChannelMarkers)) {
+      server_->broadcast(kChannelMarkers, ts,
+                         std::make_shared<const std::string>(
+                             foxglove::encode_scene_update(scene_, frame, stamp_ns)));
+    }
+    if (server_->has_subscribers(kChannelJoints)) {
+      server_->broadcast(kChannelJoints, ts,
+                         std::make_shared<const std::string>(
+                             foxglove::encode_joint_angles(scene_, frame, stamp_ns)));
+    }
+  }
+
+ private:
+  const foxglove::FoxgloveScene scene_;
+  std::unique_ptr<foxglove::Server> server_;
+  const std::string url_;
+  const std::int64_t realtime_minus_monotonic_ns_;
+};
+
+// A positive integer option (max_clients, client_queue) or the default.
+Expected<int> int_option(const OutputRequest& r, const char* key, int fallback, int max) {
+  const std::string* v = r.option(key);
+  if (v == nullptr) return fallback;
+  if (v->empty() || v->size() > 6 || v->find_first_not_of("0123456789") != std::string::npos ||
+      std::stoi(*v) < 1 || std::stoi(*v) > max) {
+    return make_error(r.where, key,
+                      "expected an integer 1.." + std::to_string(max) + ", got '" + *v + "'");
+  }
+  return std::stoi(*v);
+}
+
+Expected<foxglove::ServerOptions> options_of(const OutputRequest& r) {
+  if (r.values.size() != 1) {
+    return make_error(
+        r.where, "",
+        "expected one [ADDRESS:]PORT, got " + std::to_string(r.values.size()) + " values");
+  }
+  foxglove::ServerOptions o;
+  if (auto a = foxglove::parse_listen_address(r.values[0], r.where, o); !a) return a.error();
+  auto clients = int_option(r, "max_clients", o.max_clients, 64);
+  if (!clients) return clients.error();
+  auto queue = int_option(r, "client_queue", o.client_queue_depth, 4096);
+  if (!queue) return queue.error();
+  o.max_clients = *clients;
+  o.client_queue_depth = *queue;
+  return o;
+}
+
+Expected<void> check_foxglove(const OutputRequest& r) {
+  auto o = options_of(r);
+  if (!o) return o.error();
+  return {};
+}
+
+Expected<OutputCreated> create_foxglove(const OutputRequest& r, const OutputContext& ctx) {
+  auto o = options_of(r);
+  if (!o) return o.error();
+  if (ctx.targets == nullptr) return make_error(r.where, "", "needs the targets (none given)");
+  auto scene = foxglove::make_scene(*ctx.targets, ctx.model);
+  if (!scene) return scene.error();
+  auto server = foxglove::Server::create(*o, foxglove::live_view_channels());
+  if (!server) {  // "foxglove: ADDR:PORT: cannot listen: ..." -> under the request's name
+    std::string m = server.error().message;
+    if (m.rfind("foxglove: ", 0) == 0) m.erase(0, 10);
+    return make_error(r.where, "", m);
+  }
+  const std::string host =
+      o->address.find(':') != std::string::npos ? "[" + o->address + "]" : o->address;
+  const std::string url = "ws://" + host + ":" + std::to_string((*server)->port());
+  (*server)->start();
+  auto sink = std::make_unique<FoxgloveSink>(std::move(*scene), std::move(*server), url);
+  if (auto s = sink->start(); !s) return s.error();
+  OutputCreated out;
+  out.notice = sink->notice();
+  out.sink = std::move(sink);
+  return out;
+}
+
+}  // namespace
+
+extern const OutputKind kFoxgloveOutput;
+const OutputKind kFoxgloveOutput{
+    "foxglove", "Foxglove WebSocket live view on [ADDRESS:]PORT (docs/foxglove.md)",
+    &check_foxglove, &create_foxglove};
+
+}  // namespace mocap::publish

@@ -1,0 +1,53 @@
+// Design: the immutable model of the Foxglove live view, built once at setup from the
+// targets and the joint model (OutputContext): body names and colours, the world frame
+// id, and each calibrated joint's centre and hinge axis in its parent body's frame. The
+// encoders (encode.h) read it, never change it. Units: the model keeps the project's
+// millimetres; the encoders convert to Foxglove's metres.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/expected.h"
+#include "core/types.h"
+#include "formats/joints_yaml.h"
+#include "formats/targets_yaml.h"
+
+namespace mocap::foxglove {
+
+struct Rgba {
+  double r = 1.0, g = 1.0, b = 1.0, a = 1.0;  // 0..1
+};
+
+struct SceneBody {
+  std::string name;  // child_frame_id of its transform
+  Rgba colour;
+};
+
+struct SceneJoint {
+  std::string name;
+  JointType type = JointType::kBall;
+  int parent = -1;  // body indices
+  int child = -1;
+  bool calibrated = false;
+  Vec3 center_parent_mm = Vec3::Zero();
+  Vec3 axis_parent = Vec3::UnitZ();  // hinge only, unit length
+};
+
+struct FoxgloveScene {
+  std::string world_frame = "mocap";  // parent_frame_id of every body transform
+  double marker_diameter_mm = 12.0;
+  std::vector<SceneBody> bodies;
+  std::vector<SceneJoint> joints;  // empty without a joint model
+};
+
+// The colour of body i of n: evenly spaced, saturated hues (deterministic).
+Rgba body_colour(int index, int count) noexcept;
+
+// Fails with one line when a body name is empty or equals the world frame, or the model
+// names a body index outside the targets.
+Expected<FoxgloveScene> make_scene(const TargetSet& targets, const JointModel* model,
+                                   const std::string& world_frame = "mocap");
+
+}  // namespace mocap::foxglove

@@ -1,0 +1,195 @@
+// Tests of the live view's scene model and encoders (pipeline/foxglove/scene.h,
+// encode.h): metres, frames and quaternion order of /tf, the SceneUpdate entities
+// (points, markers coloured by body, joint centres and hinge axes posed in the world),
+// the joint angles, and robustness to damaged counts and non-finite values.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+#include "pipeline/foxglove/encode.h"
+
+namespace mocap::foxglove {
+namespace {
+
+using nlohmann::json;
+
+TargetSet two_bodies() {
+  TargetSet t;
+  t.marker_diameter_mm = 10.0;
+  t.bodies.push_back({"upper_arm", {Vec3(0, 0, 0), Vec3(50, 0, 0), Vec3(0, 50, 0)}});
+  t.bodies.push_back({"forearm", {Vec3(0, 0, 0), Vec3(40, 0, 0), Vec3(0, 40, 0)}});
+  return t;
+}
+
+JointModel elbow() {
+  JointModel m;
+  JointSpec j;
+  j.name = "elbow";
+  j.type = JointType::kHinge;
+  j.parent = "upper_arm";
+  j.child = "forearm";
+  j.parent_index = 0;
+  j.child_index = 1;
+  j.calibrated = true;
+  j.center_parent = Vec3(100, 0, 0);
+  j.axis_parent = Vec3(0, 0, 2);  // normalised by make_scene
+  m.joints.push_back(j);
+  return m;
+}
+
+// Body 0 rotated 90 deg about z and moved to (1000, 2000, 3000) mm; body 1 not found.
+publish::FrameResult frame_with_pose() {
+  publish::FrameResult f;
+  f.body_count = 2;
+  f.bodies[0].found = 1;
+  const double h = std::sqrt(0.5);
+  f.bodies[0].q_world_body = {h, 0.0, 0.0, h};  // qw, qx, qy, qz
+  f.bodies[0].t_world_body_mm = {1000.0, 2000.0, 3000.0};
+  f.bodies[1].found = 0;
+  f.marker_count = 2;
+  f.markers[0] = publish::ResultMarker{0, 1, {0, 0}, 0.1f, {{1000.0f, 2050.0f, 3000.0f}}};
+  f.markers[1] = publish::ResultMarker{1, 0, {0, 0}, 0.1f, {{10.0f, 20.0f, 30.0f}}};
+  f.point_count = 3;
+  f.points[2].X_world_mm = {{-500.0f, 0.0f, 250.0f}};
+  return f;
+}
+
+TEST(FoxgloveScene, BuildsBodiesAndJointsAndRejectsBadNames) {
+  const TargetSet t = two_bodies();
+  const JointModel m = elbow();
+  auto scene = make_scene(t, &m);
+  ASSERT_TRUE(scene.ok()) << scene.error().message;
+  ASSERT_EQ(scene->bodies.size(), 2u);
+  EXPECT_EQ(scene->world_frame, "mocap");
+  EXPECT_TRUE(scene->joints[0].calibrated);
+  EXPECT_NEAR(scene->joints[0].axis_parent.z(), 1.0, 1e-12);
+  const Rgba a = scene->bodies[0].colour, b = scene->bodies[1].colour;
+  EXPECT_GT(std::fabs(a.r - b.r) + std::fabs(a.g - b.g) + std::fabs(a.b - b.b), 0.3);
+
+  TargetSet bad = t;
+  bad.bodies[1].name = "mocap";
+  auto e = make_scene(bad, nullptr);
+  ASSERT_FALSE(e.ok());
+  EXPECT_NE(e.error().message.find("body 1"), std::string::npos) << e.error().message;
+  JointModel broken = m;
+  broken.joints[0].child_index = 5;
+  EXPECT_FALSE(make_scene(t, &broken).ok());
+}
+
+TEST(FoxgloveEncode, FrameTransformsInMetresWithXyzwQuaternions) {
+  const TargetSet t = two_bodies();
+  const FoxgloveScene scene = make_scene(t, nullptr).value();
+  const json j =
+      json::parse(encode_frame_transforms(scene, frame_with_pose(), 1'700'000'000'123'456'789));
+  ASSERT_EQ(j["transforms"].size(), 1u);  // only the found body
+  const json& tf = j["transforms"][0];
+  EXPECT_EQ(tf["parent_frame_id"], "mocap");
+  EXPECT_EQ(tf["child_frame_id"], "upper_arm");
+  EXPECT_EQ(tf["timestamp"]["sec"], 1'700'000'000);
+  EXPECT_EQ(tf["timestamp"]["nsec"], 123'456'789);
+  EXPECT_DOUBLE_EQ(tf["translation"]["x"].get<double>(), 1.0);
+  EXPECT_DOUBLE_EQ(tf["translation"]["y"].get<double>(), 2.0);
+  EXPECT_DOUBLE_EQ(tf["translation"]["z"].get<double>(), 3.0);
+  EXPECT_NEAR(tf["rotation"]["z"].get<double>(), std::sqrt(0.5), 1e-12);
+  EXPECT_NEAR(tf["rotation"]["w"].get<double>(), std::sqrt(0.5), 1e-12);
+  EXPECT_NEAR(tf["rotation"]["x"].get<double>(), 0.0, 1e-12);
+}
+
+TEST(FoxgloveEncode, SceneUpdateHasPointsMarkersAndPosedJoints) {
+  const TargetSet t = two_bodies();
+  const JointModel m = elbow();
+  const FoxgloveScene scene = make_scene(t, &m).value();
+  const json j = json::parse(encode_scene_update(scene, frame_with_pose(), 5));
+  ASSERT_EQ(j["entities"].size(), 4u);
+  const json& points = j["entities"][0];
+  const json& markers = j["entities"][1];
+  const json& joints = j["entities"][3];
+  EXPECT_EQ(points["id"], "points");
+  EXPECT_EQ(points["frame_id"], "mocap");
+  ASSERT_EQ(points["spheres"].size(), 3u);
+  EXPECT_DOUBLE_EQ(points["spheres"][2]["pose"]["position"]["x"].get<double>(), -0.5);
+  ASSERT_EQ(markers["spheres"].size(), 2u);
+  EXPECT_DOUBLE_EQ(markers["spheres"][0]["size"]["x"].get<double>(), 0.01);  // 10 mm
+  EXPECT_DOUBLE_EQ(markers["spheres"][0]["color"]["r"].get<double>(), scene.bodies[0].colour.r);
+  EXPECT_DOUBLE_EQ(markers["spheres"][1]["color"]["g"].get<double>(), scene.bodies[1].colour.g);
+  EXPECT_EQ(j["entities"][2]["texts"][0]["text"], "upper_arm");
+  // Elbow centre (100,0,0) in upper_arm, rotated 90 deg about z: (0,100,0) + t.
+  ASSERT_EQ(joints["spheres"].size(), 1u);
+  const json& c = joints["spheres"][0]["pose"]["position"];
+  EXPECT_NEAR(c["x"].get<double>(), 1.0, 1e-9);
+  EXPECT_NEAR(c["y"].get<double>(), 2.1, 1e-9);
+  EXPECT_NEAR(c["z"].get<double>(), 3.0, 1e-9);
+  // The hinge arrow points along the world axis (z): +x rotated by its orientation.
+  ASSERT_EQ(joints["arrows"].size(), 1u);
+  const json& o = joints["arrows"][0]["pose"]["orientation"];
+  const Quat q(o["w"].get<double>(), o["x"].get<double>(), o["y"].get<double>(),
+               o["z"].get<double>());
+  EXPECT_NEAR((q * Vec3::UnitX() - Vec3::UnitZ()).norm(), 0.0, 1e-9);
+  // Every entity carries every field foxglove.SceneEntity requires.
+  for (const char* key :
+       {"timestamp", "frame_id", "id", "lifetime", "frame_locked", "metadata", "arrows", "cubes",
+        "spheres", "cylinders", "lines", "triangles", "texts", "models"}) {
+    EXPECT_TRUE(points.contains(key)) << key;
+  }
+}
+
+TEST(FoxgloveEncode, JointAnglesWithNamesQualityAndFiniteNumbers) {
+  const TargetSet t = two_bodies();
+  const JointModel m = elbow();
+  const FoxgloveScene scene = make_scene(t, &m).value();
+  publish::FrameResult f;
+  f.joints.sequence = 42;
+  f.joints.flags = client::kFlagAllBodiesFound;
+  f.joints.joint_count = 2;
+  f.joints.joints[0] = client::JointRecord{0, 1, 1, {0.5f, 0.0f, 0.0f}, {1, 0, 0, 0}};
+  f.joints.quality[0].solved_by = 2;
+  f.joints.quality[0].sd_rad[0] = 0.01f;
+  f.joints.joints[1] = client::JointRecord{7, 0, 0, {NAN, 0.25f, INFINITY}, {1, 0, 0, 0}};
+  const json j = json::parse(encode_joint_angles(scene, f, 0));
+  EXPECT_EQ(j["sequence"], 42);
+  EXPECT_EQ(j["all_bodies_found"], true);
+  ASSERT_EQ(j["joints"].size(), 2u);
+  EXPECT_EQ(j["joints"][0]["name"], "elbow");
+  EXPECT_EQ(j["joints"][0]["type"], "hinge");
+  EXPECT_EQ(j["joints"][0]["solved_by"], "chain");
+  ASSERT_EQ(j["joints"][0]["angles_rad"].size(), 1u);
+  EXPECT_NEAR(j["joints"][0]["angles_rad"][0].get<double>(), 0.5, 1e-7);
+  EXPECT_EQ(j["joints"][1]["name"], "joint7");
+  EXPECT_EQ(j["joints"][1]["valid"], false);
+  ASSERT_EQ(j["joints"][1]["angles_rad"].size(), 3u);
+  EXPECT_TRUE(j["joints"][1]["angles_rad"][0].is_number());  // NaN written as 0
+  EXPECT_EQ(j["joints"][1]["angles_rad"][0].get<double>(), 0.0);
+}
+
+TEST(FoxgloveEncode, DamagedCountsAreClamped) {
+  const TargetSet t = two_bodies();
+  const FoxgloveScene scene = make_scene(t, nullptr).value();
+  publish::FrameResult f;
+  f.body_count = 1000;
+  f.marker_count = -3;
+  f.point_count = 1 << 20;
+  f.markers[0].body = 200;  // not a body of the scene
+  f.joints.joint_count = 60000;
+  EXPECT_NO_THROW(json::parse(encode_frame_transforms(scene, f, -1)));
+  const json s = json::parse(encode_scene_update(scene, f, 0));
+  EXPECT_EQ(s["entities"][0]["spheres"].size(),
+            static_cast<std::size_t>(publish::kMaxResultPoints));
+  EXPECT_EQ(s["entities"][1]["spheres"].size(), 0u);
+  const json j = json::parse(encode_joint_angles(scene, f, 0));
+  EXPECT_EQ(j["joints"].size(), static_cast<std::size_t>(client::kMaxJoints));
+}
+
+TEST(FoxgloveEncode, ChannelsAdvertiseValidJsonSchemas) {
+  const auto channels = live_view_channels();
+  ASSERT_EQ(channels.size(), 3u);
+  EXPECT_EQ(channels[0].topic, "/tf");
+  EXPECT_EQ(channels[1].schema_name, "foxglove.SceneUpdate");
+  for (const auto& c : channels) {
+    const json s = json::parse(c.schema);
+    EXPECT_EQ(s["type"], "object") << c.topic;
+  }
+}
+
+}  // namespace
+}  // namespace mocap::foxglove
