@@ -27,8 +27,10 @@ Eigen::Matrix2d pixel_jacobian(const CameraModel& cam, const Vec2& xn) noexcept 
 }  // namespace
 
 Eigen::Matrix2d blob_covariance_px(const detect::Blob& blob) noexcept {
-  const double l1 = 0.25 * static_cast<double>(blob.major_axis_px) * blob.major_axis_px;
-  const double l2 = 0.25 * static_cast<double>(blob.minor_axis_px) * blob.minor_axis_px;
+  const double major = static_cast<double>(blob.major_axis_px);
+  const double minor = static_cast<double>(blob.minor_axis_px);
+  const double l1 = 0.25 * major * major;
+  const double l2 = 0.25 * minor * minor;
   const double c = std::cos(static_cast<double>(blob.orientation_rad));
   const double s = std::sin(static_cast<double>(blob.orientation_rad));
   Eigen::Matrix2d S;
@@ -56,14 +58,14 @@ Expected<MarkerShapeModel> MarkerShapeModel::create(const CameraModel& cam,
   return m;
 }
 
-bool MarkerShapeModel::predict(const Vec3& X_world, Eigen::Matrix2d& Sigma_px,
-                               Vec2& center_px) const noexcept {
+bool MarkerShapeModel::silhouette(const Vec3& X_world, Eigen::Matrix2d& S, Vec2& x0,
+                                  double& dist_mm) const noexcept {
   const Vec3 C = cam_.R_cam_world * X_world + cam_.t_cam_world;
-  const double dist = C.norm();
-  if (!(C.z() > radius_mm_) || !(dist > radius_mm_)) return false;
+  dist_mm = C.norm();
+  if (!(C.z() > radius_mm_) || !(dist_mm > radius_mm_)) return false;
   // Cone of the silhouette: x^T Q x = 0 with Q = c c^T - cos^2(alpha) I, x = (u, v, 1).
-  const Vec3 c = C / dist;
-  const double sin_a = radius_mm_ / dist;
+  const Vec3 c = C / dist_mm;
+  const double sin_a = radius_mm_ / dist_mm;
   const double cos2 = 1.0 - sin_a * sin_a;
   const Eigen::Matrix2d A =
       c.head<2>() * c.head<2>().transpose() - cos2 * Eigen::Matrix2d::Identity();
@@ -72,14 +74,41 @@ bool MarkerShapeModel::predict(const Vec3& X_world, Eigen::Matrix2d& Sigma_px,
   // A is negative definite while the whole cone stays in front of the camera.
   if (!(A.determinant() > 0.0 && A.trace() < 0.0)) return false;
   const Eigen::Matrix2d A_inv = A.inverse();
-  const Vec2 x0 = -A_inv * b;
+  x0 = -A_inv * b;
   const double kappa = b.dot(A_inv * b) - q33;  // (x - x0)^T A (x - x0) = kappa on the rim
   if (!(kappa < 0.0)) return false;
-  const Eigen::Matrix2d S = kappa * A_inv;  // ellipse {(x - x0)^T S^-1 (x - x0) <= 1}
+  S = kappa * A_inv;  // ellipse {(x - x0)^T S^-1 (x - x0) <= 1}, normalised units
+  return std::isfinite(S.sum()) && std::isfinite(x0.sum());
+}
+
+bool MarkerShapeModel::predict(const Vec3& X_world, Eigen::Matrix2d& Sigma_px,
+                               Vec2& center_px) const noexcept {
+  Eigen::Matrix2d S;
+  Vec2 x0;
+  double dist = 0.0;
+  if (!silhouette(X_world, S, x0, dist)) return false;
   const Eigen::Matrix2d J = pixel_jacobian(cam_, x0);
   Sigma_px = 0.25 * J * S * J.transpose();  // covariance of the filled ellipse
   center_px = normalized_to_pixel(cam_, x0);
   return std::isfinite(Sigma_px.sum()) && std::isfinite(center_px.sum());
+}
+
+double MarkerShapeModel::linearisation_error(const Eigen::Matrix2d& S,
+                                             const Vec2& x0) const noexcept {
+  const Eigen::Matrix2d J0 = pixel_jacobian(cam_, x0);
+  const double j0 = J0.norm();
+  if (!(j0 > 0.0)) return 0.0;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(S);
+  double lin = 0.0;
+  for (int a = 0; a < 2; ++a) {
+    // The silhouette's semi-axes (normalised units).
+    const Vec2 d = std::sqrt(std::max(es.eigenvalues()(a), 0.0)) * es.eigenvectors().col(a);
+    for (double sgn : {-1.0, 1.0}) {
+      const double e = (pixel_jacobian(cam_, x0 + sgn * d) - J0).norm() / j0;
+      lin = std::max(lin, e * e);
+    }
+  }
+  return lin;
 }
 
 ShapeCheck MarkerShapeModel::check(const detect::Blob& blob, const Vec3& X_world,
@@ -90,9 +119,12 @@ ShapeCheck MarkerShapeModel::check(const detect::Blob& blob, const Vec3& X_world
   if ((blob.flags & kSuspect) != 0U) return r;  // cut off or shared: never whole
   r.whole = true;
   if (!config_.enabled) return r;
-  Eigen::Matrix2d Sg;
-  Vec2 center;
-  if (!predict(X_world, Sg, center)) return r;  // no prediction: the flags decide
+  Eigen::Matrix2d S;
+  Vec2 x0;
+  double dist = 0.0;
+  if (!silhouette(X_world, S, x0, dist)) return r;  // no prediction: the flags decide
+  const Eigen::Matrix2d J = pixel_jacobian(cam_, x0);
+  const Eigen::Matrix2d Sg = 0.25 * J * S * J.transpose();
   const Eigen::Matrix2d Sm = blob_covariance_px(blob);
   const double t_m = Sm.trace();
   const double t_g = Sg.trace();
@@ -122,27 +154,14 @@ ShapeCheck MarkerShapeModel::check(const detect::Blob& blob, const Vec3& X_world
   const double sn2 = noise.noise_dn * noise.noise_dn + 1.0 / 12.0;
   const double var_noise = area * sn2 * R4 / 24.0;
   const double sigma = std::sqrt(var_cut + var_noise) / (W * n);
-  // Lens linearisation: the moments of the true (curved) image deviate from the
-  // Jacobian's by the square of the relative change of J across the blob.
-  Vec2 xn;
-  double lin = 0.0;
-  if (undistort_pixel(cam_, center, xn)) {
-    const Eigen::Matrix2d J0 = pixel_jacobian(cam_, xn);
-    const double j0 = J0.norm();
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(Sm);
-    for (int a = 0; a < 2; ++a) {
-      // Semi-axis of the blob (2 sigma of a filled disc), mapped back to normalised units.
-      const Vec2 d_px =
-          2.0 * std::sqrt(std::max(es.eigenvalues()(a), 0.0)) * es.eigenvectors().col(a);
-      const Vec2 d_n = J0.inverse() * d_px;
-      for (double sgn : {-1.0, 1.0}) {
-        const double e = (pixel_jacobian(cam_, xn + sgn * d_n) - J0).norm() / j0;
-        lin = std::max(lin, e * e);
-      }
-    }
-  }
-  const double persp = (radius_mm_ / (cam_.R_cam_world * X_world + cam_.t_cam_world).norm());
-  r.tolerance = z_ * sigma + lin + persp * persp;
+  // Perspective: the brightness pattern is symmetric about the ball's axis, which the
+  // projection keeps up to (rho / |C|)^2.
+  const double persp = radius_mm_ / dist;
+  r.tolerance = z_ * sigma + persp * persp;
+  // Lens linearisation (only computed when it could matter): the moments of the truly
+  // curved image deviate from the Jacobian's by the square of the relative change of J
+  // across the silhouette.
+  if (r.residual > r.tolerance) r.tolerance += linearisation_error(S, x0);
   r.whole = r.residual <= r.tolerance;
   return r;
 }

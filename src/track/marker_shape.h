@@ -68,6 +68,11 @@ class MarkerShapeModel {
   bool enabled() const noexcept { return config_.enabled; }
 
  private:
+  // The silhouette ellipse on the normalised undistorted plane: shape S, centre x0.
+  bool silhouette(const Vec3& X_world, Eigen::Matrix2d& S, Vec2& x0,
+                  double& dist_mm) const noexcept;
+  double linearisation_error(const Eigen::Matrix2d& S, const Vec2& x0) const noexcept;
+
   CameraModel cam_;
   double radius_mm_ = 6.0;
   double z_ = 4.3;

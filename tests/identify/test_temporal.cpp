@@ -101,7 +101,9 @@ TEST(Temporal, SwappedBodiesNeverGiveWrongIdentity) {
         const auto& p = out.bodies[static_cast<std::size_t>(b)];
         EXPECT_TRUE(test::identity_correct(scene, b, p)) << "frame " << f << " body " << b;
         EXPECT_TRUE(p.found) << "frame " << f << " body " << b;
-        if (f == 3) EXPECT_FALSE(p.from_prior) << "body " << b;
+        if (f == 3 && b < 2) {  // the swapped ones: by the full search
+          EXPECT_FALSE(p.from_prior) << "body " << b;
+        }
       }
     }
     EXPECT_GE(id->counters().warm_fallbacks, 2u);

@@ -126,7 +126,7 @@ class LensScene {
     }
     return truth;
   }
-  const ImageView view(int c) const { return images_[static_cast<std::size_t>(c)].view(); }
+  ImageView view(int c) const { return images_[static_cast<std::size_t>(c)].view(); }
 
  private:
   Lens lens_;
@@ -145,7 +145,8 @@ inline std::vector<Vec2> reference_centroids(const ImageView& im, double thresho
   const int w = im.width, h = im.height;
   std::vector<unsigned char> seen(static_cast<std::size_t>(w) * static_cast<std::size_t>(h), 0);
   auto at = [&](int x, int y) {
-    return im.format == PixelFormat::kMono8 ? double{im.row8(y)[x]} : double{im.row16(y)[x]};
+    return im.format == PixelFormat::kMono8 ? static_cast<double>(im.row8(y)[x])
+                                            : static_cast<double>(im.row16(y)[x]);
   };
   std::vector<Vec2> out;
   std::vector<std::pair<int, int>> stack;

@@ -5,6 +5,7 @@
 // is checked on shapes of whole and half-hidden discs and on flagged blobs.
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
 #include <cmath>
 
 #include "track/marker_shape.h"
@@ -34,7 +35,7 @@ Eigen::Matrix2d numeric_covariance(const CameraModel& cam, const Vec3& C, double
   double n = 0.0;
   Vec2 s = Vec2::Zero();
   Eigen::Matrix2d ss = Eigen::Matrix2d::Zero();
-  const double step = 0.05;
+  const double step = 0.1;
   for (double y = around_px.y() - half_px; y <= around_px.y() + half_px; y += step) {
     for (double x = around_px.x() - half_px; x <= around_px.x() + half_px; x += step) {
       Vec2 xn;
