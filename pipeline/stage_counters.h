@@ -107,7 +107,7 @@ inline constexpr std::array<CounterField<StereoCounters>, 14> kStereoFields = {{
 }};
 
 // Reported as identify_<name>.
-inline constexpr std::array<CounterField<IdentifyCounters>, 16> kIdentifyFields = {{
+inline constexpr std::array<CounterField<IdentifyCounters>, 17> kIdentifyFields = {{
     MOCAP_COUNTER_FIELD(IdentifyCounters, frames),
     MOCAP_COUNTER_FIELD(IdentifyCounters, bodies_found),
     MOCAP_COUNTER_FIELD(IdentifyCounters, full_searches),
@@ -115,6 +115,7 @@ inline constexpr std::array<CounterField<IdentifyCounters>, 16> kIdentifyFields 
     MOCAP_COUNTER_FIELD(IdentifyCounters, warm_fallbacks),
     MOCAP_COUNTER_FIELD(IdentifyCounters, conflict_researches),
     MOCAP_COUNTER_FIELD(IdentifyCounters, velocity_rejects),
+    MOCAP_COUNTER_FIELD(IdentifyCounters, jump_reboots),
     MOCAP_COUNTER_FIELD(IdentifyCounters, point_overflow),
     MOCAP_COUNTER_FIELD(IdentifyCounters, invalid_points),
     MOCAP_COUNTER_FIELD(IdentifyCounters, node_limit_hits),

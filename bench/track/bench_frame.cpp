@@ -82,6 +82,35 @@ void BM_Ours_DetectAndTriangulate(benchmark::State& state) {
 }
 BENCHMARK(BM_Ours_DetectAndTriangulate)->Unit(benchmark::kMicrosecond);
 
+// Stereo + identification + point selection on the detected blobs of the frame, with the
+// whole-marker shape model (default) and with the blob flags alone (the baseline: the
+// cost the physical shape test adds per frame).
+void process_blobs_bench(benchmark::State& state, bool shape_model) {
+  Fixture& f = fixture();
+  TrackerConfig cfg;
+  cfg.marker_shape.enabled = shape_model;
+  auto proc = FrameProcessor::create(f.scene.rig, f.scene.targets, nullptr, cfg);
+  if (!proc) std::abort();
+  FrameOutput out = proc->make_output();
+  for (int c = 0; c < 2; ++c) {
+    const auto cs = static_cast<std::size_t>(c);
+    proc->detect_camera(c, f.images[cs].view(), out.blobs[cs]);
+    out.camera_present[cs] = true;
+  }
+  std::int64_t t_ns = 0;
+  for (auto _ : state) {
+    t_ns += 10'000'000;
+    proc->process_blobs(t_ns, out);
+    benchmark::DoNotOptimize(out.poses.found);
+  }
+  state.counters["points"] = out.points.size();
+  state.counters["bodies"] = out.poses.found;
+}
+void BM_ProcessBlobs_ShapeModel(benchmark::State& state) { process_blobs_bench(state, true); }
+void BM_ProcessBlobs_FlagsOnly(benchmark::State& state) { process_blobs_bench(state, false); }
+BENCHMARK(BM_ProcessBlobs_ShapeModel)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_ProcessBlobs_FlagsOnly)->Unit(benchmark::kMicrosecond);
+
 void BM_Floor_ReadBothImages(benchmark::State& state) {
   Fixture& f = fixture();
   for (auto _ : state) {

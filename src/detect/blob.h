@@ -54,6 +54,16 @@ class BlobList {
   const Blob* end() const noexcept { return storage_.data() + size_; }
 
   void clear() noexcept { size_ = 0; }
+  // The image levels the detector used for this list's frame (background and noise
+  // sigma estimate, threshold; DN). Consumers judging blob shapes (track/marker_shape.h)
+  // read them here, on the thread that owns the list, not from the detector's counters.
+  struct Levels {
+    double background_dn = 0.0;
+    double noise_dn = 0.0;
+    double threshold_dn = 0.0;
+  };
+  void set_levels(const Levels& levels) noexcept { levels_ = levels; }
+  const Levels& levels() const noexcept { return levels_; }
   // Appends when there is room; returns false (nothing written) when full.
   bool push(const Blob& b) noexcept {
     if (size_ >= storage_.size()) return false;
@@ -64,6 +74,7 @@ class BlobList {
  private:
   std::vector<Blob> storage_;
   std::size_t size_ = 0;
+  Levels levels_{};
 };
 
 // Lifetime counters (monotonic). The last frame's values are in last_* fields.

@@ -231,6 +231,7 @@ bool BlobDetector::detect(const ImageView& img, BlobList& out) noexcept {
   counters_.last_background_dn = level;
   counters_.last_noise_dn = noise;
   counters_.last_threshold_dn = static_cast<std::uint32_t>(threshold_);
+  out.set_levels(BlobList::Levels{level, noise, static_cast<double>(threshold_)});
 
   if (img.format == PixelFormat::kMono8) {
     scan<std::uint8_t>(img);

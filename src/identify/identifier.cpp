@@ -86,7 +86,7 @@ bool Identifier::warm_match(int body, const Iso3& T_pred, SearchResult& out) noe
   const TargetModel& model = models_[static_cast<std::size_t>(body)];
   out = SearchResult{};
   out.point_of_marker.fill(-1);
-  const double gate = std::min(config_.warm_gate_mm, 0.5 * model.min_pair_mm);
+  const double gate = std::min(warm_gate_mm_, 0.5 * model.min_pair_mm);
   const double t2 = config_.t_mm * config_.t_mm;
   const int n = frame_.size();
   FitPoints src(3, kMaxMarkers), dst(3, kMaxMarkers);
@@ -228,6 +228,12 @@ bool Identifier::identify(const MeasuredPoint* pts, int n, std::int64_t timestam
     if (!config_.temporal || !tr.valid) continue;
     const double age_s = static_cast<double>(timestamp_ns - tr.t_last_ns) * 1e-9;
     if (!(age_s <= config_.max_prior_age_s)) continue;
+    // The prediction error grows with the time since the body was last seen: the gate
+    // scales with that age relative to the interval the prior was measured over.
+    const double interval_s =
+        tr.has_prev ? static_cast<double>(tr.t_last_ns - tr.t_prev_ns) * 1e-9 : age_s;
+    warm_gate_mm_ =
+        config_.warm_gate_mm * (interval_s > 0.0 && age_s > interval_s ? age_s / interval_s : 1.0);
     if (warm_match(b, predict(tr, timestamp_ns), res(b)) &&
         within_speed_limits(tr, res(b).T_world_body, timestamp_ns)) {
       st(b) = kWarm;
@@ -291,12 +297,14 @@ bool Identifier::identify(const MeasuredPoint* pts, int n, std::int64_t timestam
       }
       break;
     }
-    // 4. Speed limits: a jump is rejected and the body re-acquired next frame.
+    // 4. Speed limits: a jump beyond them invalidates the body's track. The solution
+    // at hand is a cold one (a fresh full search of this frame) and unambiguous (unique
+    // at ambiguity_ratio, consistent), so the body is re-acquired ("booted") from it in
+    // this same frame instead of being lost until the next one.
     if (!within_speed_limits(trk(best), res(best).T_world_body, timestamp_ns)) {
       ++counters_.velocity_rejects;
+      ++counters_.jump_reboots;
       trk(best) = Track{};
-      st(best) = kDone;
-      continue;
     }
     acquire_points(res(best).point_of_marker, kof(best));
     st(best) = kFound;

@@ -19,8 +19,10 @@
 //  of consistency.h first: outlier markers dropped, solutions the noise cannot explain
 //  rejected.
 //  4. a pose that moved faster than max_speed_mm_per_s / max_angular_speed_deg_per_s
-//     since the previous pose of that body is rejected (counted) and its track dropped,
-//     so the next frame re-acquires it by a full search.
+//     since the body was last seen (the limits scale with that time) drops the body's
+//     track (counted); the solution, a fresh full search of this frame that passed the
+//     ambiguity and consistency tests, re-acquires ("boots") the body in the same frame.
+//  The temporal path's gate scales with the time since the body was last seen.
 #pragma once
 
 #include <string>
@@ -88,6 +90,7 @@ class Identifier {
   IdentifyConfig config_;
   std::vector<TargetModel> models_;
   double max_pair_mm_ = 0.0;
+  double warm_gate_mm_ = 0.0;  // this body's warm gate in this frame (age-scaled)
   FramePoints frame_;
   TargetSearch search_;
   ConsistencyGate gate_;

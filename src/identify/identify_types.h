@@ -106,7 +106,8 @@ struct IdentifyCounters {
   std::uint64_t warm_accepted = 0;        // bodies found by the temporal path
   std::uint64_t warm_fallbacks = 0;       // prior present but validation failed -> search
   std::uint64_t conflict_researches = 0;  // a body lost points to a better body: re-searched
-  std::uint64_t velocity_rejects = 0;     // pose jumped beyond the limits: dropped, re-acquire
+  std::uint64_t velocity_rejects = 0;     // pose jumped beyond the limits: track dropped
+  std::uint64_t jump_reboots = 0;         // of those, re-acquired by the cold solution (same frame)
   std::uint64_t point_overflow = 0;       // points beyond max_points dropped (count of points)
   std::uint64_t invalid_points = 0;       // non-finite points ignored
   std::uint64_t node_limit_hits = 0;      // searches stopped at max_search_nodes

@@ -237,6 +237,7 @@ bool StereoTriangulator::process(const Vec2* px_a, int n_a, const Vec2* px_b, in
     const auto i = static_cast<std::size_t>(p.blob_index[static_cast<std::size_t>(cam_a_)]);
     const auto j = static_cast<std::size_t>(p.blob_index[static_cast<std::size_t>(cam_b_)]);
     p.ambiguous = use_a_[i] > 1 || use_b_[j] > 1;
+    p.reported = !p.ambiguous;
     if (p.ambiguous) ++counters_.ambiguous;
   }
   return !frame_overflow_;

@@ -42,6 +42,9 @@ struct Point3 {
   double epipolar_px = 0.0;     // max of the two symmetric epipolar distances (undistorted px)
   std::array<std::int16_t, kMaxCameras> blob_index{-1, -1, -1, -1};  // -1: camera unused
   bool ambiguous = false;  // shares a blob with another candidate of the same frame
+  // Reported as a marker (points.csv): the stereo stage reports exactly the unambiguous
+  // candidates; track/point_selection.h then resolves the ambiguous ones by evidence.
+  bool reported = false;
 };
 
 class PointList {

@@ -1,3 +1,4 @@
+// Design: see frame_processor.h.
 #include "track/frame_processor.h"
 
 #include <algorithm>
@@ -36,11 +37,16 @@ Expected<FrameProcessor> FrameProcessor::create(const Rig& rig, const TargetSet&
   }
   FrameProcessor p(rig, targets, std::move(model_copy), {std::move(*dets[0]), std::move(*dets[1])},
                    std::move(stereo).value(), std::move(ident).value(), std::move(angles));
-  if (!(config.whole_marker_min_roundness_ratio >= 0.0 &&
-        config.whole_marker_min_roundness_ratio <= 1.0))
-    return make_error(
-        "tracker", "whole_marker_min_roundness_ratio",
-        "must be in [0, 1], got " + std::to_string(config.whole_marker_min_roundness_ratio));
+  for (int c = 0; c < 2; ++c) {
+    auto shape = MarkerShapeModel::create(rig.cameras[static_cast<std::size_t>(c)],
+                                          targets.marker_diameter_mm, config.marker_shape);
+    if (!shape) return shape.error();
+    p.shapes_.push_back(std::move(shape).value());
+  }
+  auto selector = PointSelector::create(config.stereo.max_candidates,
+                                        config.stereo.max_points_per_camera, config.selection);
+  if (!selector) return selector.error();
+  p.selector_ = std::move(selector).value();
   if (model != nullptr) {
     auto chain_model = ChainModel::create(*model, targets);
     if (!chain_model) return Error{"chain tracking: " + chain_model.error().message};
@@ -55,8 +61,6 @@ Expected<FrameProcessor> FrameProcessor::create(const Rig& rig, const TargetSet&
     if (!chain) return Error{"chain tracking: " + chain.error().message};
     p.chain_.emplace(std::move(chain).value());
   }
-  p.whole_min_roundness_ratio_ = config.whole_marker_min_roundness_ratio;
-  p.whole_min_area_px_ = config.whole_marker_min_area_px;
   for (auto& c : p.centroids_px_) c.resize(static_cast<std::size_t>(config.detect.max_blobs));
   p.measured_.resize(static_cast<std::size_t>(std::max(1, config.stereo.max_candidates)));
   p.body_views_.resize(targets.bodies.size());
@@ -132,22 +136,25 @@ bool FrameProcessor::process_blobs(std::int64_t timestamp_ns, FrameOutput& out) 
     m.X_world = p.X_world;
     m.blob_index = {p.blob_index[0], p.blob_index[1]};
     m.partial = false;
-    for (std::size_t c = 0; c < 2; ++c) {
-      const int b = p.blob_index[c];
-      if (b >= 0 && static_cast<std::size_t>(b) < out.blobs[c].size() &&
-          !whole_marker_view(out.blobs[c][static_cast<std::size_t>(b)], rig_.cameras[c], p.X_world))
+    for (int c = 0; c < 2; ++c) {
+      const int b = p.blob_index[static_cast<std::size_t>(c)];
+      if (!whole_marker_view(c, out.blobs[static_cast<std::size_t>(c)], b, p.X_world))
         m.partial = true;
     }
   }
   measured_count_ = n_points;
   const bool identified = identifier_.identify(measured_.data(), n_points, timestamp_ns, out.poses);
+  // Kinematic-chain tracking (with a model): bodies solved through their joints join the
+  // poses, so the point selection below counts their points as used.
+  track_chain(n_points, timestamp_ns, out);
+  // Which candidates are reported (points.csv): one per blob, chosen by the evidence.
+  selector_.select(out.poses, timestamp_ns, out.points);
   now = monotonic_ns();
   out.times.identify = now - t;
 
   // Joint angles.
   t = now;
   if (angles_) {
-    track_chain(n_points, timestamp_ns, out);
     for (std::size_t b = 0; b < body_views_.size(); ++b) {
       body_views_[b].found = out.poses.bodies[b].found;
       body_views_[b].T_world_body = out.poses.bodies[b].T_world_body;
@@ -167,17 +174,14 @@ bool FrameProcessor::process_blobs(std::int64_t timestamp_ns, FrameOutput& out) 
   return identified;
 }
 
-bool FrameProcessor::whole_marker_view(const detect::Blob& blob, const CameraModel& cam,
+bool FrameProcessor::whole_marker_view(int camera, const detect::BlobList& blobs, int blob,
                                        const Vec3& X_world) const noexcept {
-  if (!(whole_min_roundness_ratio_ > 0.0)) return true;
-  constexpr std::uint32_t kSuspect = detect::kBlobTouchesBorder | detect::kBlobMerged |
-                                     detect::kBlobSplit | detect::kBlobTruncated;
-  if ((blob.flags & kSuspect) != 0U) return false;
-  if (static_cast<double>(blob.area_px) < whole_min_area_px_) return true;
-  // A sphere off the optical axis by theta images as an ellipse of axis ratio cos(theta).
-  const Vec3 X_cam = cam.R_cam_world * X_world + cam.t_cam_world;
-  const double cos_theta = X_cam.z() / X_cam.norm();
-  return static_cast<double>(blob.roundness) >= whole_min_roundness_ratio_ * cos_theta;
+  if (blob < 0 || static_cast<std::size_t>(blob) >= blobs.size()) return true;
+  const detect::BlobList::Levels& lv = blobs.levels();
+  const ImageNoise noise{lv.background_dn, lv.noise_dn, lv.threshold_dn};
+  return shapes_[static_cast<std::size_t>(camera)]
+      .check(blobs[static_cast<std::size_t>(blob)], X_world, noise)
+      .whole;
 }
 
 void FrameProcessor::track_chain(int n_points, std::int64_t timestamp_ns,
@@ -204,6 +208,7 @@ void FrameProcessor::track_chain(int n_points, std::int64_t timestamp_ns,
 void FrameProcessor::reset() noexcept {
   if (chain_) chain_->reset();
   identifier_.reset();
+  selector_.reset();
   if (angles_) angles_->reset();
 }
 

@@ -23,6 +23,8 @@
 #include "kinematics/joint_angles.h"
 #include "stereo/stereo_triangulator.h"
 #include "track/chain_solver.h"
+#include "track/marker_shape.h"
+#include "track/point_selection.h"
 
 namespace mocap {
 
@@ -40,13 +42,13 @@ struct TrackerConfig {
     return c;
   }()};
   // A marker's image is taken as whole when its blob is not flagged (border, merged,
-  // split, truncated) and its roundness (minor/major axis) is at least this fraction of
-  // the roundness of a whole sphere's image seen at that angle off the optical axis
-  // (cos of the angle). Otherwise its 3D point is `partial` (see identify_types.h).
-  // 0 disables the test. Blobs smaller than whole_marker_min_area_px are too coarse for
-  // the roundness to tell (pixelisation): only their flags count.
-  double whole_marker_min_roundness_ratio = 0.97;
-  double whole_marker_min_area_px = 50.0;
+  // split, truncated) and its shape agrees, in both cameras, with the silhouette the
+  // full camera model predicts for a ball of the targets' marker_diameter at its 3D
+  // point (track/marker_shape.h). Otherwise its 3D point is `partial`
+  // (identify_types.h). `marker_shape.enabled = false`: the flags alone decide.
+  MarkerShapeConfig marker_shape{};
+  // Which 3D candidates are reported (Point3::reported; track/point_selection.h).
+  PointSelectionConfig selection{};
   // Kinematic-chain tracking, used whenever a model is loaded. Its point noise, partial
   // noise, confidence and angular speed bound are taken from `identify` at create() (one
   // source for each); the other keys are its own.
@@ -121,12 +123,11 @@ class FrameProcessor {
   // Chain tracking after identification: chain-solved bodies join out.poses.
   void track_chain(int n_points, std::int64_t timestamp_ns, FrameOutput& out) noexcept;
   // False when the blob of a marker at X_world does not look like a whole marker.
-  bool whole_marker_view(const detect::Blob& blob, const CameraModel& cam,
+  bool whole_marker_view(int camera, const detect::BlobList& blobs, int blob,
                          const Vec3& X_world) const noexcept;
 
   Rig rig_;
-  double whole_min_roundness_ratio_ = 0.0;
-  double whole_min_area_px_ = 0.0;
+  std::vector<MarkerShapeModel> shapes_;  // one per stereo camera
   TargetSet targets_;
   JointModel model_;
   std::array<detect::BlobDetector, 2> detectors_;
@@ -139,6 +140,7 @@ class FrameProcessor {
   std::array<std::vector<Vec2>, 2> centroids_px_;
   std::vector<MeasuredPoint> measured_;
   int measured_count_ = 0;
+  PointSelector selector_;
   std::vector<kinematics::BodyPoseView> body_views_;
 };
 

@@ -17,19 +17,6 @@ namespace {
 
 constexpr double kRadToDeg = 180.0 / M_PI;
 
-// A point goes to points.csv unless it is an epipolar-ambiguous candidate that no body
-// used: such candidates are kept only for identification to choose from.
-void mark_used_points(const FrameOutput& out, std::vector<char>& used) {
-  std::fill(used.begin(), used.end(), 0);
-  for (int b = 0; b < out.poses.count; ++b) {
-    const BodyPose& body = out.poses.bodies[static_cast<std::size_t>(b)];
-    if (!body.found) continue;
-    for (std::int16_t idx : body.point_index_of_marker) {
-      if (idx >= 0 && static_cast<std::size_t>(idx) < used.size()) used[static_cast<std::size_t>(idx)] = 1;
-    }
-  }
-}
-
 }  // namespace
 
 Expected<OfflineTrackResult> track_recording(const OfflineTrackOptions& opt) {
@@ -86,7 +73,6 @@ Expected<OfflineTrackResult> track_recording(const OfflineTrackOptions& opt) {
   }
 
   FrameOutput out = proc->make_output();
-  std::vector<char> used(static_cast<std::size_t>(out.points.capacity()), 0);
   std::array<Image, 2> images;
   PointRow point_row;
   PoseRow pose_row;
@@ -116,10 +102,9 @@ Expected<OfflineTrackResult> track_recording(const OfflineTrackOptions& opt) {
     ++result.stats->frames;
     ++result.frames;
 
-    mark_used_points(out, used);
     for (int i = 0; i < out.points.size(); ++i) {
       const Point3& p = out.points[i];
-      if (p.ambiguous && !used[static_cast<std::size_t>(i)]) continue;
+      if (!p.reported) continue;  // lost its blob to a better candidate (point_selection.h)
       point_row.frame = fe.frame;
       point_row.X_world = p.X_world;
       point_row.reproj_px = p.reproj_px;

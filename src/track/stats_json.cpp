@@ -32,6 +32,7 @@ std::vector<std::pair<std::string, std::uint64_t>> collect_counters(const FrameP
   c.emplace_back("identify_warm_accepted", i.warm_accepted);
   c.emplace_back("identify_warm_fallbacks", i.warm_fallbacks);
   c.emplace_back("identify_velocity_rejects", i.velocity_rejects);
+  c.emplace_back("identify_jump_reboots", i.jump_reboots);
   c.emplace_back("identify_point_overflow", i.point_overflow);
   c.emplace_back("identify_node_limit_hits", i.node_limit_hits);
   if (const ChainCounters* k = p.chain_counters()) {

@@ -77,7 +77,9 @@ TEST(Temporal, SameIdentitiesAsFullSearch) {
 }
 
 // Frame 1: bodies at their places; frame 2: the two bodies swap places (the prior of each
-// lands on the other's points). No wrong identity, with and without speed limits.
+// lands on the other's points). No wrong identity, with and without speed limits; with
+// limits the jump drops both tracks and the unambiguous cold solutions re-acquire both
+// bodies in the same frame.
 TEST(Temporal, SwappedBodiesNeverGiveWrongIdentity) {
   std::mt19937_64 rng(61);
   const TargetSet set = three_bodies(rng);
@@ -98,22 +100,21 @@ TEST(Temporal, SwappedBodiesNeverGiveWrongIdentity) {
       for (int b = 0; b < 3; ++b) {
         const auto& p = out.bodies[static_cast<std::size_t>(b)];
         EXPECT_TRUE(test::identity_correct(scene, b, p)) << "frame " << f << " body " << b;
-        if (f != 3 || !limits || b == 2) {
-          EXPECT_TRUE(p.found) << "frame " << f << " body " << b;
+        EXPECT_TRUE(p.found) << "frame " << f << " body " << b;
+        if (f == 3 && b < 2) {  // the swapped ones: by the full search
+          EXPECT_FALSE(p.from_prior) << "body " << b;
         }
-      }
-      if (f == 3 && limits) {  // the swapped bodies jumped 300 mm in 10 ms: rejected
-        EXPECT_FALSE(out.bodies[0].found);
-        EXPECT_FALSE(out.bodies[1].found);
       }
     }
     EXPECT_GE(id->counters().warm_fallbacks, 2u);
     EXPECT_EQ(id->counters().velocity_rejects, limits ? 2u : 0u);
+    EXPECT_EQ(id->counters().jump_reboots, limits ? 2u : 0u);
   }
 }
 
-// A jump of one body: rejected once (counted), re-acquired by a full search next frame.
-TEST(Temporal, JumpRejectedThenReacquired) {
+// A jump of one body: its track is dropped (counted) and its unambiguous cold solution
+// re-acquires it in the same frame ("boot"); the temporal path resumes afterwards.
+TEST(Temporal, JumpRebootsInTheSameFrame) {
   std::mt19937_64 rng(71);
   const TargetSet set = three_bodies(rng);
   IdentifyConfig cfg;
@@ -122,24 +123,63 @@ TEST(Temporal, JumpRejectedThenReacquired) {
   ASSERT_TRUE(id.ok());
   std::vector<Iso3> poses{moving_pose(0, 0), moving_pose(1, 0), moving_pose(2, 0)};
   bool found[5];
+  bool warm[5];
   for (int f = 0; f < 5; ++f) {
     if (f == 2) poses[2].translation() += Vec3(0.0, 300.0, 0.0);  // 30 m/s for one frame
     const auto scene = make_scene(rng, set, SceneOptions{0.1, 5, false, 3, 300.0}, &poses);
     BodyPoses out;
     id->identify(scene.pts.data(), static_cast<int>(scene.pts.size()), f * 10'000'000LL, out);
     found[f] = out.bodies[2].found;
+    warm[f] = out.bodies[2].from_prior;
     EXPECT_TRUE(test::identity_correct(scene, 2, out.bodies[2]));
     EXPECT_TRUE(out.bodies[0].found && out.bodies[1].found);
   }
-  EXPECT_TRUE(found[0] && found[1]);
-  EXPECT_FALSE(found[2]);
-  EXPECT_TRUE(found[3] && found[4]);
+  EXPECT_TRUE(found[0] && found[1] && found[2] && found[3] && found[4]);
+  EXPECT_FALSE(warm[2]);  // booted from the full search
+  EXPECT_TRUE(warm[4]);   // tracked again
   EXPECT_EQ(id->counters().velocity_rejects, 1u);
+  EXPECT_EQ(id->counters().jump_reboots, 1u);
   // A timestamp going backwards drops the priors (counted), identification goes on.
   const auto scene = make_scene(rng, set, SceneOptions{0.1, 5, false, 3, 300.0}, &poses);
   BodyPoses out;
   EXPECT_TRUE(id->identify(scene.pts.data(), static_cast<int>(scene.pts.size()), 0, out));
   EXPECT_EQ(id->counters().bad_timestamps, 1u);
+}
+
+// The temporal gate scales with the time since the body was last seen: a body hidden for
+// 3 frames that moved more than 3 gates meanwhile is still taken by its prior on return.
+TEST(Temporal, GateScalesWithTimeSinceLastSeen) {
+  std::mt19937_64 rng(83);
+  const TargetSet set = three_bodies(rng);
+  TargetSet others;
+  others.bodies = {set.bodies[0], set.bodies[1]};
+  IdentifyConfig cfg;
+  cfg.motion_model = MotionModel::kConstantPose;
+  cfg.warm_gate_mm = 3.0;  // the body moves 2.5 mm per frame
+  auto id = Identifier::create(set, cfg);
+  ASSERT_TRUE(id.ok());
+  auto pose = [](int body, int f) {
+    Iso3 T = moving_pose(body, 0);
+    T.translation() += Vec3(2.5 * f, 0.0, 0.0);
+    return T;
+  };
+  for (int f = 0; f < 7; ++f) {
+    const bool hidden = f >= 2 && f <= 4;
+    std::vector<Iso3> poses{pose(0, f), pose(1, f), pose(2, f)};
+    std::vector<Iso3> two{poses[0], poses[1]};
+    const auto scene = hidden
+                           ? make_scene(rng, others, SceneOptions{0.05, 0, false, 3, 300.0}, &two)
+                           : make_scene(rng, set, SceneOptions{0.05, 0, false, 3, 300.0}, &poses);
+    BodyPoses out;
+    id->identify(scene.pts.data(), static_cast<int>(scene.pts.size()), f * 10'000'000LL, out);
+    EXPECT_EQ(out.bodies[2].found, !hidden) << "frame " << f;
+    if (f == 5) {  // 10 mm from where it was last seen, 4 frames ago: gate 4 x 3 mm
+      EXPECT_TRUE(out.bodies[2].from_prior);
+      EXPECT_TRUE(test::identity_correct(scene, 2, out.bodies[2]));
+    }
+  }
+  // Without the scaling the prior would have failed: a gate of 3 mm around a 10 mm move.
+  EXPECT_EQ(id->counters().velocity_rejects, 0u);
 }
 
 }  // namespace
