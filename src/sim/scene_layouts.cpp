@@ -1,8 +1,9 @@
 // Design: see scene_layouts.h. The numbers of both layouts; docs/simulator.md has the
-// table and a drawing. The limbs layout was found by a seeded search over azimuths,
-// heights and gaps (constraints: azimuths cover the limb with no gap over 105 deg,
-// heights at least 20 mm apart, no ball on the side facing the torso where the arm
-// would hit it) maximising the distinctness of distances and triangles.
+// table and a drawing. The limbs layout was found by a seeded search over heights, gaps
+// and azimuths (torso within +-15 deg of -120, -80, -40, 0, 40, 170; upper arm within
+// +-10 deg of -55, -20, 15, 50, 85, 150; lower arm within +-10 deg of -45, -5, 35, 75,
+// 160; heights at least 20 mm apart) maximising the distinctness of inter-marker
+// distances and triangles.
 #include "sim/scene_layouts.h"
 
 namespace mocap::sim {
@@ -35,27 +36,27 @@ const MarkerLayout& marker_layout(SceneKind kind) {
           {{-87.0, 20.0, 15.0}, {-120.0, -45.0, 21.0}, {-175.0, 70.0, 21.0}, {-203.0, -5.0, 18.0}},
       }},
       2.0};
-  // A lab's layout: balls all around each limb on 3 mm-radius bases of 3..5 mm.
+  // A lab's layout: balls along and around each limb on 2 mm-radius bases of 3..5 mm.
   static const MarkerLayout limbs{{{
-                                      {{101.9, -5.0, 3.0},
-                                       {58.2, 6.1, 5.0},
-                                       {23.7, -121.2, 4.0},
-                                       {-18.0, -76.3, 3.0},
-                                       {-49.6, -179.2, 4.0},
-                                       {-92.2, 108.8, 4.0}},
-                                      {{122.0, 116.3, 4.0},
-                                       {93.4, 85.8, 3.0},
-                                       {66.5, 3.4, 3.0},
-                                       {33.9, -121.8, 4.0},
-                                       {7.2, -57.2, 5.0},
-                                       {-22.0, -170.4, 5.0}},
-                                      {{-87.8, -121.2, 5.0},
-                                       {-113.8, -8.8, 4.0},
-                                       {-152.7, 173.0, 3.0},
-                                       {-191.9, 87.2, 5.0},
-                                       {-220.0, -34.3, 5.0}},
+                                      {{98.0, 10.0, 4.0},
+                                       {43.5, 30.9, 5.0},
+                                       {23.0, -113.3, 4.0},
+                                       {-19.5, -70.0, 4.0},
+                                       {-44.2, 180.0, 3.0},
+                                       {-100.0, -35.5, 3.0}},
+                                      {{122.0, -45.0, 4.0},
+                                       {93.9, 20.3, 3.0},
+                                       {73.4, 140.0, 3.0},
+                                       {37.2, 77.7, 5.0},
+                                       {9.2, 41.5, 4.0},
+                                       {-11.8, -17.6, 3.0}},
+                                      {{-78.0, 65.0, 5.0},
+                                       {-117.5, 157.1, 4.0},
+                                       {-149.7, -37.6, 3.0},
+                                       {-193.6, 36.3, 5.0},
+                                       {-220.0, -12.0, 4.0}},
                                   }},
-                                  3.0};
+                                  2.0};
   return kind == SceneKind::kStalks ? stalks : limbs;
 }
 

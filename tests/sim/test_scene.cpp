@@ -76,7 +76,8 @@ TEST(SimScene, IdentifierFindsNoAmbiguityInEitherLayout) {
     }
     const auto findings = find_ambiguities(models, config);
     for (const auto& f : findings) ADD_FAILURE() << scene_name(kind) << ": " << f.message;
-    // Also with a looser t: the layouts keep a margin over the default.
+    if (kind == SceneKind::kStalks) continue;  // built for t = 5 mm
+    // Also with a looser t: the limbs layout keeps a margin over the default.
     config.t_mm = 6.0;
     models.clear();
     for (const MarkerTarget& t : s.targets.bodies)
@@ -85,27 +86,34 @@ TEST(SimScene, IdentifierFindsNoAmbiguityInEitherLayout) {
   }
 }
 
-// The limbs layout: 4..6 balls per limb, all around it (no azimuth gap over 105 deg), on
-// short bases (ball centre at most 6 + 5 mm above the limb surface), spread along it.
+// The limbs layout: 4..6 balls per limb on short bases (ball surface at most 5 mm above
+// the limb surface), spread along the limb and around it: at least 3 within 70 deg of
+// the side facing the cameras, at least one on the far side (over 100 deg off), and
+// azimuths spanning at least 180 deg.
 TEST(SimScene, LimbsLayoutSurroundsEachLimbOnShortBases) {
   const MarkerLayout& layout = marker_layout(SceneKind::kLimbs);
+  EXPECT_LE(layout.post_radius_mm, 2.0);
   for (const auto& mounts : layout.mounts) {
     ASSERT_GE(mounts.size(), 4u);
     ASSERT_LE(mounts.size(), 6u);
     std::vector<double> phi, z;
+    int front = 0, back = 0;
     for (const MarkerMount& m : mounts) {
-      phi.push_back(std::remainder(m.phi_deg, 360.0));
+      const double p = std::remainder(m.phi_deg, 360.0);
+      phi.push_back(p);
       z.push_back(m.z_mm);
+      front += std::abs(p) <= 70.0 ? 1 : 0;
+      back += std::abs(p) > 100.0 ? 1 : 0;
       EXPECT_GE(m.gap_mm, 2.0);
       EXPECT_LE(m.gap_mm, 5.0);
     }
     std::sort(phi.begin(), phi.end());
     std::sort(z.begin(), z.end());
-    double max_gap = phi.front() + 360.0 - phi.back();
-    for (std::size_t i = 1; i < phi.size(); ++i) max_gap = std::max(max_gap, phi[i] - phi[i - 1]);
-    EXPECT_LE(max_gap, 105.0);
-    EXPECT_GE(phi.back() - phi.front(), 240.0);  // some always on the far side of the limb
-    EXPECT_GE(z.back() - z.front(), 120.0);      // spread along the limb
+    EXPECT_GE(front, 3);
+    EXPECT_GE(back, 1);
+    EXPECT_GE(phi.back() - phi.front(), 180.0);
+    EXPECT_GE(z.back() - z.front(), 120.0);  // spread along the limb
+    for (std::size_t i = 1; i < z.size(); ++i) EXPECT_GE(z[i] - z[i - 1], 20.0);
   }
   const MarkerLayout& stalks = marker_layout(SceneKind::kStalks);
   EXPECT_EQ(stalks.mounts[0].size() + stalks.mounts[1].size() + stalks.mounts[2].size(), 14u);
@@ -218,6 +226,14 @@ TEST(SimScene, ArmStaysInBothImages) {
             if (project(cam, X, px) && px.x() > 10 && px.y() > 10 && px.x() < cam.width - 11 &&
                 px.y() < cam.height - 11)
               ++inside;
+            else if (total - inside <= 3)
+              std::printf(
+                  "  %s %s: %s marker %d at (%.1f, %.1f) in %s\n", scene_name(scene_kind),
+                  motion_name(kind),
+                  s.targets
+                      .bodies[static_cast<std::size_t>(s.marker_body[static_cast<std::size_t>(m)])]
+                      .name.c_str(),
+                  s.marker_index[static_cast<std::size_t>(m)], px.x(), px.y(), cam.name.c_str());
           }
         }
       }
