@@ -3,13 +3,13 @@
 // differs:
 //  - limbs  (default): what a robot lab builds, like the paper's targets: 6, 6 and 5
 //           balls spread along each limb and around it, each on a short base (3..5 mm
-//           between the limb surface and the ball). Four balls of each limb (three on
-//           the lower arm) lie within about +-65 deg of the side facing the cameras, the
-//           others on the far sides and the back: several are cleanly visible from the
-//           cameras over the motions and the viewpoints, some are always behind the
-//           limb. A ball seen more than about 75 deg off its own axis loses a sliver of
-//           its rim to its base, and the limb hides it from about 110 deg on; no ball
-//           sits on the side of the arm facing the torso, where the arm would hit it.
+//           between the limb surface and the ball). Four balls of each limb lie within
+//           70 deg of the side facing the cameras, the others on the far sides and the
+//           back: several are cleanly visible from the cameras over the motions and the
+//           viewpoints, some are always behind the limb. A ball seen more than about
+//           75 deg off its own axis loses a sliver of its rim to its base, and the limb
+//           hides it from about 110 deg on; no ball sits on the side of the arm facing
+//           the torso, where the arm would hit it.
 //  - stalks (stress variant): the original scene, 5, 5 and 4 balls on 10..25 mm stalks
 //           on the side facing the cameras (azimuth -80..+70 deg), so that a few
 //           limb occlusions remove most of a target.
@@ -19,7 +19,7 @@
 // limb to the ball centre (it occludes like any limb). Layout numbers were chosen so that
 // within a target all inter-marker distances differ by > 3 mm and no triangle of any
 // target matches another triangle (of the same or another target) within 7 mm: the
-// identifier's ambiguity check (t = 5 mm, and 6 mm) finds nothing (tested in tests/sim).
+// identifier's ambiguity check finds nothing at t = 5 mm (limbs: also 6 mm; tests/sim).
 #pragma once
 
 #include <array>
