@@ -1,5 +1,6 @@
 // Design: `mocap simulate --out DIR [options]`: parses the flags with CLI11 and calls
-// mocap::sim::write_simulated_recording (the library entry point). Errors are one line
+// mocap::sim::write_simulated_recording (the library entry point); --scene picks the
+// marker layout, --rig renders through a user-given rig. Errors are one line
 // on stderr with exit code 2; success prints a one-line summary on stdout.
 #include <cstdio>
 #include <string>
@@ -16,6 +17,7 @@ void register_simulate(CLI::App& app, int& exit_code) {
   struct Args {
     std::string out;
     std::string motion = "smooth";
+    std::string scene = "limbs";
     sim::SimOptions opt;
     std::uint64_t seed = 1;
     bool noise_given = false;
@@ -25,6 +27,11 @@ void register_simulate(CLI::App& app, int& exit_code) {
       "simulate", "Write a synthetic stereo recording of the shoulder test rig with ground truth");
   cmd->add_option("--out", args->out, "Output folder (created if needed)")->required();
   cmd->add_option("--frames", args->opt.frames, "Number of frames (default 100)");
+  cmd->add_option("--scene", args->scene,
+                  "Marker layout: limbs (markers all around the limbs) | stalks (stress "
+                  "variant) (default limbs)");
+  cmd->add_option("--rig", args->opt.rig_path,
+                  "Render through this rig.yaml (2 cameras) instead of the built-in pair");
   cmd->add_option("--motion", args->motion,
                   "smooth | poses | move400 | viewpoints | wand | lframe (default smooth)");
   cmd->add_option("--seed", args->seed, "Random seed of noise, drop-outs and strays (default 1)");
@@ -49,6 +56,12 @@ void register_simulate(CLI::App& app, int& exit_code) {
                   "Number of static poses of --motion poses (default 22)");
   cmd->add_option("--threads", args->opt.threads, "Rendering threads, 1 or 2 (default 2)");
   cmd->callback([args, &exit_code]() {
+    auto scene = sim::parse_scene(args->scene);
+    if (!scene) {
+      exit_code = fail(scene.error().message);
+      return;
+    }
+    args->opt.scene = *scene;
     if (args->motion == "wand" || args->motion == "lframe") {  // rig calibration recordings
       args->opt.seed = args->seed;
       ProgressBar bar("simulate", args->opt.frames);
@@ -90,12 +103,12 @@ void register_simulate(CLI::App& app, int& exit_code) {
       return;
     }
     std::printf(
-        "simulate: wrote %d frames x %d cameras (%s) to %s in %.2f s: %lld isolated, %lld "
-        "occluded, "
-        "%lld dropped marker views, %lld glints\n",
-        r->frames, r->cameras, sim::motion_name(args->opt.motion), args->out.c_str(), r->seconds,
-        static_cast<long long>(r->isolated_views), static_cast<long long>(r->occluded_views),
-        static_cast<long long>(r->dropped_views), static_cast<long long>(r->stray_blobs));
+        "simulate: wrote %d frames x %d cameras (%s, scene %s) to %s in %.2f s: %lld "
+        "isolated, %lld occluded, %lld dropped marker views, %lld glints\n",
+        r->frames, r->cameras, sim::motion_name(args->opt.motion), sim::scene_name(args->opt.scene),
+        args->out.c_str(), r->seconds, static_cast<long long>(r->isolated_views),
+        static_cast<long long>(r->occluded_views), static_cast<long long>(r->dropped_views),
+        static_cast<long long>(r->stray_blobs));
     exit_code = 0;
   });
 }

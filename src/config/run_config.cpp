@@ -299,8 +299,8 @@ void read_identification(const YAML::Node& node, IdentifyConfig& c) {
       node, "identification",
       {"t_mm", "min_markers", "best_pairs", "ambiguity_ratio", "residual_floor_mm",
        "max_search_nodes", "temporal", "warm_gate_mm", "warm_min_markers", "max_prior_age_s",
-       "max_speed_mm_per_s", "max_angular_speed_deg_per_s", "point_sigma_mm",
-       "partial_sigma_mm", "consistency_confidence", "exclude_partial_markers", "min_whole_markers"});
+       "max_speed_mm_per_s", "max_angular_speed_deg_per_s", "point_sigma_mm", "partial_sigma_mm",
+       "consistency_confidence", "exclude_partial_markers", "min_whole_markers"});
   set(c.t_mm, positive(s, "t_mm", 1000.0));
   set(c.min_markers, s.integer("min_markers", 3, 64));
   set(c.best_pairs, s.integer("best_pairs", 1, 100000));
@@ -338,11 +338,16 @@ Expected<RunConfig> parse(const std::string& path, const YAML::Node& root) {
   read_detection(top.node("detection"), cfg.tracker.detect);
   read_stereo(top.node("stereo"), cfg.tracker.stereo);
   read_identification(top.node("identification"), cfg.tracker.identify);
-  const Section sim(top.node("sim"), "sim", {"loop_frames"});
+  const Section sim(top.node("sim"), "sim", {"loop_frames", "scene"});
   set(cfg.sim.loop_frames, sim.integer("loop_frames", 2, 2000));
-  if (sim.has("loop_frames") && cfg.cameras[0].backend != CameraBackend::kSim)
-    sim.bad("loop_frames", std::string("only used by the sim backend (cameras use ") +
-                               to_string(cfg.cameras[0].backend) + ")");
+  set(cfg.sim.scene,
+      sim.choice<mocap::sim::SceneKind>("scene", {{"limbs", mocap::sim::SceneKind::kLimbs},
+                                                  {"stalks", mocap::sim::SceneKind::kStalks}}));
+  for (const char* key : {"loop_frames", "scene"}) {
+    if (sim.has(key) && cfg.cameras[0].backend != CameraBackend::kSim)
+      sim.bad(key, std::string("only used by the sim backend (cameras use ") +
+                       to_string(cfg.cameras[0].backend) + ")");
+  }
   const Section svc(top.node("service"), "service", {"status_interval_s", "log_interval_s"});
   set(cfg.service.status_interval_s, svc.number("status_interval_s", 0.1, 3600.0));
   set(cfg.service.log_interval_s, svc.number("log_interval_s", 0.0, 86400.0));

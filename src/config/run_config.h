@@ -19,6 +19,7 @@
 
 #include "core/expected.h"
 #include "core/image.h"
+#include "sim/scene_layouts.h"
 #include "track/frame_processor.h"
 
 namespace mocap::config {
@@ -81,7 +82,8 @@ struct OutputSettings {
 };
 
 struct SimSettings {
-  int loop_frames = 200;  // frames pre-rendered for the sim backend
+  int loop_frames = 200;                          // frames pre-rendered for the sim backend
+  sim::SceneKind scene = sim::SceneKind::kLimbs;  // marker layout of the simulated robot
 };
 
 struct ServiceSettings {

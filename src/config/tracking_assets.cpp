@@ -10,6 +10,7 @@ namespace mocap::config {
 sim::SimOptions sim_options(const RunConfig& cfg) {
   sim::SimOptions so;
   so.frames = cfg.sim.loop_frames;
+  so.scene = cfg.sim.scene;
   so.fps = cfg.pipeline.trigger_rate_hz;
   return so;
 }

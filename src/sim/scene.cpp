@@ -10,6 +10,7 @@
 #include <string>
 
 #include "core/rotation.h"
+#include "sim/scene_rig.h"
 #include "sim/sim_rng.h"
 
 namespace mocap::sim {
@@ -42,12 +43,6 @@ CameraModel make_camera(const std::string& name, double x_mm, double fx, double 
   cam.t_cam_world = -R * center;
   return cam;
 }
-
-struct MarkerPlacement {
-  double z_mm;     // height on the limb axis (world, reference configuration)
-  double phi_deg;  // azimuth around the axis: 0 faces the cameras (-Y), positive towards +X
-  double stalk_mm;
-};
 
 struct Limb {
   Vec3 a_world, b_world;
@@ -94,6 +89,7 @@ Expected<SimScene> build_shoulder_scene(const SceneOptions& options) {
   SimScene scene;
   scene.imaging = im;
   scene.marker_radius_mm = 6.0;
+  scene.kind = options.kind;
   scene.rig.cameras.push_back(make_camera("cam0", -238.5, 1291.2, 1290.6, 517.3, 385.9,
                                           {-0.121, 0.083, 0.0004, -0.0003, 0.0}, 0.3));
   scene.rig.cameras.push_back(make_camera("cam1", 238.5, 1288.7, 1288.1, 513.8, 389.4,
@@ -117,22 +113,8 @@ Expected<SimScene> build_shoulder_scene(const SceneOptions& options) {
       {{shoulder_world, elbow_world, 35.0}},
       {{elbow_world, Vec3(-60.0, 40.0, -235.0), 28.0}},
   }};
-  // Marker placements on each body's main limb: 5, 5 and 4 markers (chosen so that all
-  // inter-marker distances of a target differ by > 5 mm and no triangle of one target
-  // matches one of another within 9 mm).
-  const std::array<std::vector<MarkerPlacement>, kBodyCount> placements = {{
-      {{150.0, -20.0, 12.0},
-       {95.0, 35.0, 18.0},
-       {10.0, -50.0, 10.0},
-       {-60.0, 15.0, 25.0},
-       {-110.0, -35.0, 15.0}},
-      {{115.0, -30.0, 20.0},
-       {78.0, 60.0, 19.0},
-       {46.0, 0.0, 17.0},
-       {2.0, -80.0, 17.0},
-       {-26.0, 40.0, 12.0}},
-      {{-87.0, 20.0, 15.0}, {-120.0, -45.0, 21.0}, {-175.0, 70.0, 21.0}, {-203.0, -5.0, 18.0}},
-  }};
+  // Marker mounts on each body's main limb (scene_layouts.cpp).
+  const MarkerLayout& layout = marker_layout(options.kind);
   const std::array<const char*, kBodyCount> names = {"torso", "upper_arm", "lower_arm"};
 
   scene.targets.marker_diameter_mm = 2.0 * scene.marker_radius_mm;
@@ -146,13 +128,13 @@ Expected<SimScene> build_shoulder_scene(const SceneOptions& options) {
                                        limb.radius_mm, b == kLowerArm});
     }
     const Limb& main = limbs[ub][0];
-    for (const MarkerPlacement& p : placements[ub]) {
+    for (const MarkerMount& p : layout.mounts[ub]) {
       const Vec3 axis_pt(main.a_world.x(), main.a_world.y(), p.z_mm);
       const Vec3 dir = radial_dir(p.phi_deg);
-      const Vec3 center = axis_pt + dir * (main.radius_mm + p.stalk_mm + scene.marker_radius_mm);
-      const Vec3 stalk_root = axis_pt + dir * (main.radius_mm - 3.0);
-      scene.capsules.push_back(
-          Capsule{b, T_body_world * stalk_root, T_body_world * center, 2.0, false});
+      const Vec3 center = axis_pt + dir * (main.radius_mm + p.gap_mm + scene.marker_radius_mm);
+      const Vec3 post_root = axis_pt + dir * (main.radius_mm - 3.0);
+      scene.capsules.push_back(Capsule{b, T_body_world * post_root, T_body_world * center,
+                                       layout.post_radius_mm, false});
       scene.marker_body.push_back(b);
       scene.marker_index.push_back(static_cast<int>(target.markers_body.size()));
       target.markers_body.push_back(T_body_world * center);
@@ -197,6 +179,12 @@ Expected<SimScene> build_shoulder_scene(const SceneOptions& options) {
   elbow.extra.emplace_back("zero_q_parent_child",
                            std::vector<double>{q0.w(), q0.x(), q0.y(), q0.z()});
   scene.joints_true.joints = {shoulder, elbow};
+
+  if (options.rig) {  // a user-given rig replaces the built-in pair
+    const std::string source = options.rig_source.empty() ? "rig" : options.rig_source;
+    if (auto r = check_rig_for_scene(*options.rig, scene, source); !r) return r.error();
+    scene.rig = *options.rig;
+  }
 
   // Shiny spots (glints) on the limbs, placed from the seed.
   Rng rng(hash_mix(options.seed, 0x6C696E74ull));

@@ -1,8 +1,10 @@
 // Design: the simulator's built-in scenario, the paper's shoulder test rig: three
 // rigid bodies (torso, upper_arm, lower_arm), each a set of capsules (limbs and the
-// short stalks that hold the 12 mm marker balls) carrying a marker target, a ball
-// joint (shoulder: torso -> upper_arm) and a hinge (elbow: upper_arm -> lower_arm),
-// seen by a verged stereo pair like the paper's. SimScene is immutable after
+// posts that hold the 12 mm marker balls) carrying a marker target, a ball joint
+// (shoulder: torso -> upper_arm) and a hinge (elbow: upper_arm -> lower_arm), seen by a
+// verged stereo pair like the paper's, or by a user-given rig (scene_rig.h). Two marker
+// layouts (scene_layouts.h): `limbs` (default, markers all around each limb on short
+// bases) and `stalks` (the stress variant). SimScene is immutable after
 // build_shoulder_scene(); a SceneState (body poses + noise key) is what changes per
 // frame. apply_config() is the forward kinematics: allocation-free, noexcept.
 // World frame: X to the right as seen from the cameras, Y away from the cameras
@@ -11,6 +13,8 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "camera/camera_model.h"
@@ -18,6 +22,7 @@
 #include "core/types.h"
 #include "formats/joints_yaml.h"
 #include "formats/targets_yaml.h"
+#include "sim/scene_layouts.h"
 
 namespace mocap::sim {
 
@@ -71,12 +76,16 @@ struct ImagingParams {
 ImagingParams default_imaging(int bits, int maxval);
 
 struct SceneOptions {
+  SceneKind kind = SceneKind::kLimbs;  // marker layout
+  std::optional<Rig> rig;              // user-given cameras (checked); none: the built-in pair
+  std::string rig_source;              // names the user rig in errors (its file)
   std::uint64_t seed = 1;
   int stray_glints = 0;  // number of shiny spots on the limbs
   ImagingParams imaging{};
 };
 
 struct SimScene {
+  SceneKind kind = SceneKind::kLimbs;
   Rig rig;
   TargetSet targets;                   // marker positions per body (body frames)
   JointModel joints_true;              // calibrated = true: the true model (gt/model_true.yaml)

@@ -73,6 +73,13 @@ Expected<SimScene> make_scene(const SimOptions& o) {
   if (o.bits == 16 && (maxval < 256 || maxval > 65535))
     return make_error("simulate", "maxval", "must be 256..65535 for 16-bit output");
   SceneOptions so;
+  so.kind = o.scene;
+  if (!o.rig_path.empty()) {
+    auto rig = load_rig(o.rig_path);
+    if (!rig) return rig.error();
+    so.rig = std::move(rig).value();
+    so.rig_source = o.rig_path;
+  }
   so.seed = o.seed;
   so.stray_glints = o.stray;
   so.imaging = default_imaging(o.bits, maxval);

@@ -18,6 +18,8 @@
 namespace mocap::sim {
 
 struct SimOptions {
+  SceneKind scene = SceneKind::kLimbs;  // marker layout (scene_layouts.h)
+  std::string rig_path;                 // user rig (rig.yaml) instead of the built-in pair
   int frames = 100;
   MotionKind motion = MotionKind::kSmooth;
   std::uint64_t seed = 1;

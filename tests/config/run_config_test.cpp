@@ -150,6 +150,22 @@ TEST(RunConfig, SimAssetsDefaultToTheScene) {
   EXPECT_TRUE(check_tracking_assets(cfg));
 }
 
+TEST(RunConfig, SimSceneSelectsTheMarkerLayout) {
+  EXPECT_EQ(default_run_config().sim.scene, sim::SceneKind::kLimbs);
+  EXPECT_EQ(sim_options(default_run_config()).scene, sim::SceneKind::kLimbs);
+  TempDir dir("cfg_scene");
+  write_file(dir.file("m.yaml"), "sim: {scene: stalks, loop_frames: 20}\n");
+  auto cfg = load_run_config(dir.file("m.yaml"));
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  EXPECT_EQ(cfg->sim.scene, sim::SceneKind::kStalks);
+  const sim::SimOptions so = sim_options(*cfg);
+  EXPECT_EQ(so.scene, sim::SceneKind::kStalks);
+  auto scene = sim::make_scene(so);
+  ASSERT_TRUE(scene);
+  EXPECT_EQ(scene->marker_count(), 14);  // the stalk layout's 5 + 5 + 4 balls
+  EXPECT_TRUE(check_tracking_assets(*cfg));
+}
+
 TEST(RunConfig, HostPortCheck) {
   EXPECT_TRUE(check_host_port("f", "k", "127.0.0.1:7755"));
   EXPECT_TRUE(check_host_port("f", "k", "[::1]:1"));

@@ -1,7 +1,8 @@
-// Scene tests: the rig is the paper's, the targets are distinguishable (distinct
-// inter-marker distances, non-congruent targets), the true joint model is consistent
-// with the forward kinematics, the joint angles follow the documented conventions,
-// and the arm stays in both images over the motions.
+// Scene tests: the rig is the paper's, the targets of both marker layouts are
+// distinguishable (distinct inter-marker distances, non-congruent targets, nothing for
+// the identifier's ambiguity check), the limbs layout surrounds each limb, the true
+// joint model is consistent with the forward kinematics, the joint angles follow the
+// documented conventions, and the arm stays in both images over the motions.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -10,6 +11,8 @@
 #include <numbers>
 
 #include "core/rotation.h"
+#include "identify/ambiguity.h"
+#include "identify/target_model.h"
 #include "sim/motion.h"
 #include "sim/simulate.h"
 
@@ -23,6 +26,16 @@ SimScene default_scene() {
   EXPECT_TRUE(s.ok());
   return *s;
 }
+
+SimScene scene_of(SceneKind kind) {
+  SimOptions o;
+  o.scene = kind;
+  auto s = make_scene(o);
+  EXPECT_TRUE(s.ok()) << s.error().message;
+  return *s;
+}
+
+constexpr SceneKind kScenes[] = {SceneKind::kLimbs, SceneKind::kStalks};
 
 TEST(SimScene, StereoRigLikeThePaper) {
   const SimScene s = default_scene();
@@ -42,45 +55,112 @@ TEST(SimScene, StereoRigLikeThePaper) {
   EXPECT_LT(std::acos(z0.dot(z1)) / kDeg, 40.0);
 }
 
-TEST(SimScene, TargetsHaveDistinctDistancesAndAreNotCongruent) {
-  const SimScene s = default_scene();
-  ASSERT_EQ(s.targets.bodies.size(), 3u);
-  std::vector<std::vector<double>> dists;
-  for (const MarkerTarget& t : s.targets.bodies) {
-    EXPECT_GE(t.markers_body.size(), 4u);
-    EXPECT_LE(t.markers_body.size(), 6u);
-    std::vector<double> d;
-    for (std::size_t i = 0; i < t.markers_body.size(); ++i)
-      for (std::size_t j = i + 1; j < t.markers_body.size(); ++j)
-        d.push_back((t.markers_body[i] - t.markers_body[j]).norm());
-    std::sort(d.begin(), d.end());
-    EXPECT_GT(d.front(), 20.0) << t.name;  // balls well apart
-    for (std::size_t k = 1; k < d.size(); ++k)
-      EXPECT_GT(d[k] - d[k - 1], 2.0) << t.name << " distance " << d[k];
-    dists.push_back(d);
+TEST(SimScene, DefaultIsTheLimbsLayoutAndNamesParse) {
+  EXPECT_EQ(default_scene().kind, SceneKind::kLimbs);
+  EXPECT_EQ(*parse_scene("limbs"), SceneKind::kLimbs);
+  EXPECT_EQ(*parse_scene("stalks"), SceneKind::kStalks);
+  const auto bad = parse_scene("arms");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_EQ(bad.error().message, "simulate: scene: unknown scene 'arms' (limbs|stalks)");
+}
+
+TEST(SimScene, IdentifierFindsNoAmbiguityInEitherLayout) {
+  for (SceneKind kind : kScenes) {
+    const SimScene s = scene_of(kind);
+    IdentifyConfig config;  // the defaults of `mocap track` and `mocap run` (t = 5 mm)
+    std::vector<TargetModel> models;
+    for (const MarkerTarget& t : s.targets.bodies) {
+      auto m = make_target_model(t, config, t.name);
+      ASSERT_TRUE(m.ok()) << m.error().message;
+      models.push_back(*m);
+    }
+    const auto findings = find_ambiguities(models, config);
+    for (const auto& f : findings) ADD_FAILURE() << scene_name(kind) << ": " << f.message;
+    if (kind == SceneKind::kStalks) continue;  // built for t = 5 mm
+    // Also with a looser t: the limbs layout keeps a margin over the default.
+    config.t_mm = 6.0;
+    models.clear();
+    for (const MarkerTarget& t : s.targets.bodies)
+      models.push_back(*make_target_model(t, config, t.name));
+    EXPECT_TRUE(find_ambiguities(models, config).empty()) << scene_name(kind);
   }
-  // Non-congruent: no triangle of one target matches a triangle of another within 2 mm.
-  auto triangles = [&](const MarkerTarget& t) {
-    std::vector<std::array<double, 3>> out;
-    const auto& m = t.markers_body;
-    for (std::size_t i = 0; i < m.size(); ++i)
-      for (std::size_t j = i + 1; j < m.size(); ++j)
-        for (std::size_t k = j + 1; k < m.size(); ++k) {
-          std::array<double, 3> e = {(m[i] - m[j]).norm(), (m[j] - m[k]).norm(),
-                                     (m[i] - m[k]).norm()};
-          std::sort(e.begin(), e.end());
-          out.push_back(e);
-        }
-    return out;
-  };
-  for (std::size_t a = 0; a < 3; ++a)
-    for (std::size_t b = a + 1; b < 3; ++b)
-      for (const auto& ta : triangles(s.targets.bodies[a]))
-        for (const auto& tb : triangles(s.targets.bodies[b])) {
-          const double diff =
-              std::max({std::abs(ta[0] - tb[0]), std::abs(ta[1] - tb[1]), std::abs(ta[2] - tb[2])});
-          EXPECT_GT(diff, 2.0) << s.targets.bodies[a].name << " vs " << s.targets.bodies[b].name;
-        }
+}
+
+// The limbs layout: 4..6 balls per limb on short bases (ball surface at most 5 mm above
+// the limb surface), spread along the limb and around it: at least 3 within 70 deg of
+// the side facing the cameras, at least one on the far side (over 100 deg off), and
+// azimuths spanning at least 180 deg.
+TEST(SimScene, LimbsLayoutSurroundsEachLimbOnShortBases) {
+  const MarkerLayout& layout = marker_layout(SceneKind::kLimbs);
+  EXPECT_LE(layout.post_radius_mm, 2.0);
+  for (const auto& mounts : layout.mounts) {
+    ASSERT_GE(mounts.size(), 4u);
+    ASSERT_LE(mounts.size(), 6u);
+    std::vector<double> phi, z;
+    int front = 0, back = 0;
+    for (const MarkerMount& m : mounts) {
+      const double p = std::remainder(m.phi_deg, 360.0);
+      phi.push_back(p);
+      z.push_back(m.z_mm);
+      front += std::abs(p) <= 70.0 ? 1 : 0;
+      back += std::abs(p) > 100.0 ? 1 : 0;
+      EXPECT_GE(m.gap_mm, 2.0);
+      EXPECT_LE(m.gap_mm, 5.0);
+    }
+    std::sort(phi.begin(), phi.end());
+    std::sort(z.begin(), z.end());
+    EXPECT_GE(front, 3);
+    EXPECT_GE(back, 1);
+    EXPECT_GE(phi.back() - phi.front(), 180.0);
+    EXPECT_GE(z.back() - z.front(), 120.0);  // spread along the limb
+    for (std::size_t i = 1; i < z.size(); ++i) EXPECT_GE(z[i] - z[i - 1], 20.0);
+  }
+  const MarkerLayout& stalks = marker_layout(SceneKind::kStalks);
+  EXPECT_EQ(stalks.mounts[0].size() + stalks.mounts[1].size() + stalks.mounts[2].size(), 14u);
+}
+
+TEST(SimScene, TargetsHaveDistinctDistancesAndAreNotCongruent) {
+  for (SceneKind kind : kScenes) {
+    SCOPED_TRACE(scene_name(kind));
+    const SimScene s = scene_of(kind);
+    ASSERT_EQ(s.targets.bodies.size(), 3u);
+    std::vector<std::vector<double>> dists;
+    for (const MarkerTarget& t : s.targets.bodies) {
+      EXPECT_GE(t.markers_body.size(), 4u);
+      EXPECT_LE(t.markers_body.size(), 6u);
+      std::vector<double> d;
+      for (std::size_t i = 0; i < t.markers_body.size(); ++i)
+        for (std::size_t j = i + 1; j < t.markers_body.size(); ++j)
+          d.push_back((t.markers_body[i] - t.markers_body[j]).norm());
+      std::sort(d.begin(), d.end());
+      EXPECT_GT(d.front(), 20.0) << t.name;  // balls well apart
+      for (std::size_t k = 1; k < d.size(); ++k)
+        EXPECT_GT(d[k] - d[k - 1], 2.0) << t.name << " distance " << d[k];
+      dists.push_back(d);
+    }
+    // Non-congruent: no triangle of one target matches a triangle of another within 2 mm.
+    auto triangles = [&](const MarkerTarget& t) {
+      std::vector<std::array<double, 3>> out;
+      const auto& m = t.markers_body;
+      for (std::size_t i = 0; i < m.size(); ++i)
+        for (std::size_t j = i + 1; j < m.size(); ++j)
+          for (std::size_t k = j + 1; k < m.size(); ++k) {
+            std::array<double, 3> e = {(m[i] - m[j]).norm(), (m[j] - m[k]).norm(),
+                                       (m[i] - m[k]).norm()};
+            std::sort(e.begin(), e.end());
+            out.push_back(e);
+          }
+      return out;
+    };
+    for (std::size_t a = 0; a < 3; ++a)
+      for (std::size_t b = a + 1; b < 3; ++b)
+        for (const auto& ta : triangles(s.targets.bodies[a]))
+          for (const auto& tb : triangles(s.targets.bodies[b])) {
+            const double diff = std::max(
+                {std::abs(ta[0] - tb[0]), std::abs(ta[1] - tb[1]), std::abs(ta[2] - tb[2])});
+            EXPECT_GT(diff, 2.0) << s.targets.bodies[a].name << " vs " << s.targets.bodies[b].name;
+          }
+  }
 }
 
 TEST(SimScene, TrueModelIsConsistentWithTheKinematics) {
@@ -123,35 +203,45 @@ TEST(SimScene, HingeAngleSignFollowsTheRightHandRule) {
 }
 
 TEST(SimScene, ArmStaysInBothImages) {
-  const SimScene s = default_scene();
-  for (MotionKind kind :
-       {MotionKind::kSmooth, MotionKind::kPoses, MotionKind::kMove400, MotionKind::kViewpoints}) {
-    MotionSpec spec;
-    spec.kind = kind;
-    spec.frames = 220;
-    auto plan = plan_motion(s, spec);
-    ASSERT_TRUE(plan.ok());
-    SceneState st = make_state(s);
-    int inside = 0, total = 0;
-    for (const JointConfig& cfg : plan->configs) {
-      apply_config(s, cfg, st);
-      for (int m = 0; m < s.marker_count(); ++m) {
-        const Vec3 X =
-            st.T_world_body[static_cast<std::size_t>(s.marker_body[static_cast<std::size_t>(m)])] *
-            s.marker_in_body(m);
-        for (const CameraModel& cam : s.rig.cameras) {
-          Vec2 px;
-          ++total;
-          if (project(cam, X, px) && px.x() > 10 && px.y() > 10 && px.x() < cam.width - 11 &&
-              px.y() < cam.height - 11)
-            ++inside;
+  for (SceneKind scene_kind : kScenes) {
+    const SimScene s = scene_of(scene_kind);
+    for (MotionKind kind :
+         {MotionKind::kSmooth, MotionKind::kPoses, MotionKind::kMove400, MotionKind::kViewpoints}) {
+      MotionSpec spec;
+      spec.kind = kind;
+      spec.frames = 220;
+      auto plan = plan_motion(s, spec);
+      ASSERT_TRUE(plan.ok());
+      SceneState st = make_state(s);
+      int inside = 0, total = 0;
+      for (const JointConfig& cfg : plan->configs) {
+        apply_config(s, cfg, st);
+        for (int m = 0; m < s.marker_count(); ++m) {
+          const Vec3 X = st.T_world_body[static_cast<std::size_t>(
+                             s.marker_body[static_cast<std::size_t>(m)])] *
+                         s.marker_in_body(m);
+          for (const CameraModel& cam : s.rig.cameras) {
+            Vec2 px;
+            ++total;
+            if (project(cam, X, px) && px.x() > 10 && px.y() > 10 && px.x() < cam.width - 11 &&
+                px.y() < cam.height - 11)
+              ++inside;
+            else if (total - inside <= 3)
+              std::printf(
+                  "  %s %s: %s marker %d at (%.1f, %.1f) in %s\n", scene_name(scene_kind),
+                  motion_name(kind),
+                  s.targets
+                      .bodies[static_cast<std::size_t>(s.marker_body[static_cast<std::size_t>(m)])]
+                      .name.c_str(),
+                  s.marker_index[static_cast<std::size_t>(m)], px.x(), px.y(), cam.name.c_str());
+          }
         }
       }
+      const double frac = static_cast<double>(inside) / total;
+      std::printf("motion %s: %.2f%% of marker projections inside both images\n", motion_name(kind),
+                  100.0 * frac);
+      EXPECT_EQ(inside, total) << motion_name(kind) << " " << scene_name(scene_kind);
     }
-    const double frac = static_cast<double>(inside) / total;
-    std::printf("motion %s: %.2f%% of marker projections inside both images\n", motion_name(kind),
-                100.0 * frac);
-    EXPECT_EQ(inside, total) << motion_name(kind);
   }
 }
 

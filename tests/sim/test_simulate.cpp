@@ -30,7 +30,9 @@ TEST(SimRecording, LoadsBackAndGroundTruthIsConsistent) {
   auto sum = write_simulated_recording(opt, dir.path());
   ASSERT_TRUE(sum.ok()) << sum.error().message;
   EXPECT_EQ(sum->frames, 12);
-  EXPECT_EQ(sum->marker_views, 12 * 14 * 2);
+  const int markers_per_frame = make_scene(opt)->marker_count();  // 17 (limbs layout)
+  EXPECT_EQ(markers_per_frame, 17);
+  EXPECT_EQ(sum->marker_views, 12 * markers_per_frame * 2);
 
   auto rec = Recording::open(dir.path());
   ASSERT_TRUE(rec.ok()) << rec.error().message;
@@ -78,7 +80,7 @@ TEST(SimRecording, LoadsBackAndGroundTruthIsConsistent) {
   // Ground-truth marker table: one row per marker and frame.
   const std::string markers = test::read_file(dir.file("gt/markers.csv"));
   EXPECT_EQ(markers.rfind("frame,body,marker,x,y,z,u0,v0,vis0,u1,v1,vis1", 0), 0u);
-  EXPECT_EQ(test::line_count(markers), 1 + 12 * 14);
+  EXPECT_EQ(test::line_count(markers), 1 + 12 * markers_per_frame);
   EXPECT_TRUE(fs::exists(dir.file("gt/strays.csv")));
   EXPECT_EQ(test::line_count(test::read_file(dir.file("gt/segments.csv"))), 1 + 4);
 }
