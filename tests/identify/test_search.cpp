@@ -81,7 +81,8 @@ TEST(TargetSearch, AgreesWithExhaustiveSearch) {
     if (fast.unique(cfg.ambiguity_ratio)) {
       ++unique;
       EXPECT_TRUE(test::identity_correct(
-          scene, 0, BodyPose{true, false, fast.T_world_body, fast.m, 0, 0, fast.point_of_marker}))
+          scene, 0,
+          BodyPose{true, false, false, fast.T_world_body, fast.m, 0, 0, fast.point_of_marker}))
           << "trial " << trial;
     }
   }
