@@ -35,7 +35,9 @@ struct Case {
 
 Case make_case(const std::array<std::vector<int>, 3>& visible, const std::array<bool, 3>& found) {
   Case c;
-  c.scene = sim::build_shoulder_scene({}).value();
+  sim::SceneOptions options;
+  options.kind = sim::SceneKind::kStalks;  // the marker indices below are this layout's
+  c.scene = sim::build_shoulder_scene(options).value();
   sim::JointConfig jc;
   jc.shoulder_rad = Vec3(-20, -30, -20) * kDeg;
   jc.elbow_rad = 30 * kDeg;

@@ -55,6 +55,8 @@ TEST(FrameResultBuilder, JointsPosesLabelledMarkersAndPoints) {
   out->angles.joints[0].a0 = 0.1;
   out->angles.joints[0].a1 = -0.2;
   out->angles.joints[0].a2 = 0.3;
+  out->angles.joints[0].solved_by = client::SolvedBy::kPoses;
+  out->angles.joints[0].sd_rad = {0.001, 0.002, 0.003};
   out->angles.joints[1].valid = false;
   out->angles.joints[1].type = JointType::kHinge;
 
@@ -74,6 +76,7 @@ TEST(FrameResultBuilder, JointsPosesLabelledMarkersAndPoints) {
   EXPECT_EQ(r->joints.joints[1].type, static_cast<std::uint8_t>(client::JointKind::kHinge));
   EXPECT_EQ(r->joints.quality[0].solved_by, static_cast<std::uint8_t>(client::SolvedBy::kPoses));
   EXPECT_EQ(r->joints.quality[1].solved_by, static_cast<std::uint8_t>(client::SolvedBy::kNone));
+  EXPECT_FLOAT_EQ(r->joints.quality[0].sd_rad[2], 0.003f);
 
   ASSERT_EQ(r->body_count, 2);
   EXPECT_EQ(r->bodies[0].found, 1);

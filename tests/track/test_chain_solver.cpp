@@ -25,7 +25,9 @@ struct Fixture {
   double noise_mm = 0.05;
 
   static Fixture make(const ChainConfig& config = {}) {
-    auto scene = sim::build_shoulder_scene({});
+    sim::SceneOptions options;
+    options.kind = sim::SceneKind::kStalks;  // the marker indices below are this layout's
+    auto scene = sim::build_shoulder_scene(options);
     EXPECT_TRUE(scene.ok());
     auto model = ChainModel::create(scene->joints_true, scene->targets);
     EXPECT_TRUE(model.ok()) << model.error().message;
