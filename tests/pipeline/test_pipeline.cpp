@@ -110,10 +110,13 @@ TEST(Pipeline, PublishesFramesInOrderWithTrueAngles) {
 
 TEST(Pipeline, SlowSinkDropsAreCountedAndNothingIsPublishedTwice) {
   SimRigFixture rig;
-  RecordingSink sink(1000, 20000);  // 20 ms per message at 200 frames/s
+  // 20 ms per message (50 messages/s) at 100 frames/s: the sink is the bottleneck, while
+  // detection and identification keep up even under ThreadSanitizer (at 200 frames/s the
+  // instrumented upstream stages dropped first, so the publish drops were not exercised).
+  RecordingSink sink(1000, 20000);
   PipelineOptions opt = test::test_options();
   opt.max_frames = 100;
-  opt.trigger_rate_hz = 200.0;
+  opt.trigger_rate_hz = 100.0;
   auto p = Pipeline::create(rig.processor(), rig.cameras(), {&sink}, opt);
   ASSERT_TRUE(p.ok());
   ASSERT_TRUE((*p)->start().ok());
