@@ -4,8 +4,9 @@
 #      `mocap` end-to-end checks, the fuzz-corpus replays and the fault-injection tests;
 #   2. ThreadSanitizer: the tests labelled "concurrency" (rings, pipeline, publishers,
 #      service, faults).
-# Both at -O1 without debug info (sanitizer reports still name the functions), which keeps
-# CI (2 cores) under its 20-minute budget. The optimised build (-O2, the shipped flags,
+# Both at -O1 without debug info (sanitizer reports still name the functions), the tests'
+# own code at -O0, and as unity builds (CMAKE_UNITY_BUILD: a few sources per compiler
+# run), which keeps the CI time (2 cores) down. The optimised build (-O2, the shipped flags,
 # plus the benchmarks) runs the same suite when MOCAP_TEST_OPTIMISED=1; `deploy/demo.sh`
 # builds the Release binary.
 # This is the README's second command and exactly what .ci/run runs.
@@ -31,7 +32,8 @@ fi
 if [ "${MOCAP_TEST_SKIP_SANITIZERS:-0}" != "1" ]; then
   echo "== build: AddressSanitizer + UndefinedBehaviorSanitizer"
   cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-    -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1" -DMOCAP_SANITIZE="address;undefined" -DMOCAP_BUILD_BENCH=OFF >/dev/null
+    -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1" -DMOCAP_SANITIZE="address;undefined" -DMOCAP_BUILD_BENCH=OFF \
+    -DCMAKE_UNITY_BUILD=ON >/dev/null
   cmake --build build-asan -j"$jobs" --target mocap mocap_all_tests
   echo "== test: AddressSanitizer + UndefinedBehaviorSanitizer"
   ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
@@ -39,7 +41,8 @@ if [ "${MOCAP_TEST_SKIP_SANITIZERS:-0}" != "1" ]; then
 
   echo "== build: ThreadSanitizer (concurrency tests)"
   cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-    -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1" -DMOCAP_SANITIZE=thread -DMOCAP_BUILD_BENCH=OFF >/dev/null
+    -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1" -DMOCAP_SANITIZE=thread -DMOCAP_BUILD_BENCH=OFF \
+    -DCMAKE_UNITY_BUILD=ON >/dev/null
   cmake --build build-tsan -j"$jobs" --target mocap_concurrency_tests
   echo "== test: ThreadSanitizer"
   TSAN_OPTIONS=halt_on_error=1 MOCAP_SANITIZER=tsan \

@@ -7,7 +7,7 @@
 namespace mocap::hal {
 namespace {
 
-constexpr int kMaxBuffers = 32;
+constexpr int kMaxReplayBuffers = 32;
 
 }  // namespace
 
@@ -52,7 +52,7 @@ Expected<void> ReplayCamera::configure(const CameraConfig& want) {
                           std::to_string(m.height) + ", configured " + std::to_string(want.width) +
                           "x" + std::to_string(want.height));
   }
-  if (auto r = check_buffer_count(want.buffer_count, kMaxBuffers); !r) return r;
+  if (auto r = check_buffer_count(want.buffer_count, kMaxReplayBuffers); !r) return r;
   config_ = want;
   notice_.clear();
   if (want.exposure_us > 0 || want.gain >= 0.0 || want.frame_rate_hz > 0.0) {

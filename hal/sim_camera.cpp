@@ -15,7 +15,7 @@
 namespace mocap::hal {
 namespace {
 
-constexpr int kMaxBuffers = 64;
+constexpr int kMaxSimBuffers = 64;
 
 }  // namespace
 
@@ -129,7 +129,7 @@ Expected<void> SimCamera::configure(const CameraConfig& want) {
                       std::string("the simulated camera renders ") +
                           (im.format() == PixelFormat::kMono8 ? "8" : "16") + "-bit images");
   }
-  if (auto r = check_buffer_count(want.buffer_count, kMaxBuffers); !r) return r;
+  if (auto r = check_buffer_count(want.buffer_count, kMaxSimBuffers); !r) return r;
   if (want.trigger == TriggerMode::kFreeRun && !(want.frame_rate_hz > 0.0)) {
     return make_error(name_, "frame_rate_hz", "free-run needs a rate > 0");
   }

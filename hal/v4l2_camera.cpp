@@ -17,7 +17,7 @@
 namespace mocap::hal {
 namespace {
 
-constexpr int kMaxBuffers = 32;
+constexpr int kMaxV4l2Buffers = 32;
 
 std::uint32_t fourcc_of(PixelFormat f) noexcept {
   return f == PixelFormat::kMono8 ? V4L2_PIX_FMT_GREY : V4L2_PIX_FMT_Y16;
@@ -141,7 +141,7 @@ Expected<void> V4l2Camera::configure(const CameraConfig& want) {
         name_, "size",
         "must be positive, got " + std::to_string(want.width) + "x" + std::to_string(want.height));
   }
-  if (auto r = check_buffer_count(want.buffer_count, kMaxBuffers); !r) return r;
+  if (auto r = check_buffer_count(want.buffer_count, kMaxV4l2Buffers); !r) return r;
   state_ = CameraState::kClosed;
   notice_.clear();
   config_ = want;
@@ -321,10 +321,10 @@ Expected<void> V4l2Camera::start() {
   req.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
   req.memory = V4L2_MEMORY_MMAP;
   if (xioctl(VIDIOC_REQBUFS, &req) < 0) return sys_error("start: VIDIOC_REQBUFS", errno);
-  if (req.count < 2 || req.count > kMaxBuffers) {
+  if (req.count < 2 || req.count > kMaxV4l2Buffers) {
     return make_error(name_, "start",
                       "driver granted " + std::to_string(req.count) + " buffers (need 2.." +
-                          std::to_string(kMaxBuffers) + ")");
+                          std::to_string(kMaxV4l2Buffers) + ")");
   }
   // A failed call: undo the mapping, then the error of the call's errno.
   auto fail_start = [this](const char* what) {

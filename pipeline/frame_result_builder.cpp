@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 #include "core/rotation.h"
 #include "track/labelled_markers.h"
@@ -92,6 +93,47 @@ void make_frame_result(std::uint64_t sequence, std::int64_t capture_ns, const Ta
                     static_cast<float>(l.X_world_mm.z())};
   }
   result.marker_count = markers;
+
+  // Each camera's blobs, and what they became: a labelled marker, a point, or nothing.
+  const int cameras = std::min(static_cast<int>(out.blobs.size()), publish::kMaxResultCameras);
+  result.camera_count = cameras;
+  for (int c = 0; c < cameras; ++c) {
+    const detect::BlobList& blobs = out.blobs[static_cast<std::size_t>(c)];
+    publish::CameraBlobs& cb = result.cameras[static_cast<std::size_t>(c)];
+    cb.present = out.camera_present[static_cast<std::size_t>(c)] ? 1 : 0;
+    cb.count = std::min(static_cast<int>(blobs.size()), publish::kMaxResultBlobs);
+    for (int i = 0; i < cb.count; ++i) {
+      const detect::Blob& b = blobs[static_cast<std::size_t>(i)];
+      publish::ResultBlob& r = cb.blobs[static_cast<std::size_t>(i)];
+      r = publish::ResultBlob{};
+      r.x_px = static_cast<float>(b.x_px);
+      r.y_px = static_cast<float>(b.y_px);
+      r.diameter_px = 2.0f * std::sqrt(std::max(0.0f, b.area_px) / std::numbers::pi_v<float>);
+    }
+  }
+  const auto blob_of = [&](int point, int c) -> publish::ResultBlob* {
+    if (point < 0 || point >= out.points.size()) return nullptr;
+    const std::int16_t bi = out.points[point].blob_index[static_cast<std::size_t>(c)];
+    const publish::CameraBlobs& cb = result.cameras[static_cast<std::size_t>(c)];
+    if (bi < 0 || bi >= cb.count) return nullptr;
+    return &result.cameras[static_cast<std::size_t>(c)].blobs[static_cast<std::size_t>(bi)];
+  };
+  for (int p = 0; p < out.points.size(); ++p) {
+    for (int c = 0; c < cameras; ++c) {
+      if (publish::ResultBlob* r = blob_of(p, c))
+        r->use = static_cast<std::uint8_t>(publish::BlobUse::kPoint);
+    }
+  }
+  for (int i = 0; i < labelled.count; ++i) {
+    const LabelledMarker& l = labelled.items[static_cast<std::size_t>(i)];
+    for (int c = 0; c < cameras; ++c) {
+      publish::ResultBlob* r = blob_of(l.point, c);
+      if (r == nullptr) continue;
+      r->use = static_cast<std::uint8_t>(publish::BlobUse::kMarker);
+      r->body = static_cast<std::uint8_t>(std::clamp<int>(l.body, 0, 255));
+      r->marker = static_cast<std::uint8_t>(std::clamp<int>(l.marker, 0, 255));
+    }
+  }
 }
 
 }  // namespace mocap::pipeline

@@ -17,14 +17,13 @@
 #include <vector>
 
 #include "core/latency_stats.h"
+#include "core/units.h"
 #include "kinematics/joint_angles.h"
 #include "sim/scene.h"
 #include "track/chain_solver.h"
 
 namespace mocap {
 namespace {
-
-constexpr double kDeg = std::numbers::pi / 180.0;
 
 struct Case {
   sim::SimScene scene;
@@ -39,8 +38,8 @@ Case make_case(const std::array<std::vector<int>, 3>& visible, const std::array<
   options.kind = sim::SceneKind::kStalks;  // the marker indices below are this layout's
   c.scene = sim::build_shoulder_scene(options).value();
   sim::JointConfig jc;
-  jc.shoulder_rad = Vec3(-20, -30, -20) * kDeg;
-  jc.elbow_rad = 30 * kDeg;
+  jc.shoulder_rad = Vec3(-20, -30, -20) * kRadPerDeg;
+  jc.elbow_rad = 30 * kRadPerDeg;
   sim::SceneState st = sim::make_state(c.scene);
   sim::apply_config(c.scene, jc, st);
   std::mt19937 rng(3);
@@ -60,8 +59,8 @@ Case make_case(const std::array<std::vector<int>, 3>& visible, const std::array<
       p.X_world = st.T_world_body[ub] * markers[m] + Vec3(n(rng), n(rng), n(rng));
       p.blob_index = {static_cast<std::int16_t>(c.pts.size()),
                       static_cast<std::int16_t>(c.pts.size())};
-      if (found[ub]) c.poses.bodies[ub].point_index_of_marker[m] =
-          static_cast<std::int16_t>(c.pts.size());
+      if (found[ub])
+        c.poses.bodies[ub].point_index_of_marker[m] = static_cast<std::int16_t>(c.pts.size());
       c.full.bodies[ub].point_index_of_marker[m] = static_cast<std::int16_t>(c.pts.size());
       c.pts.push_back(p);
     }
@@ -109,8 +108,10 @@ void run_chain(benchmark::State& state, const std::array<std::vector<int>, 3>& v
   LatencyRecorder rec(1 << 20);
   std::int64_t t = 1'000'000'000;
   for (auto _ : state) {
-    if (warm) solver.remember(c.full, t);
-    else solver.reset();
+    if (warm)
+      solver.remember(c.full, t);
+    else
+      solver.reset();
     t += 10'000'000;
     const std::int64_t t0 = monotonic_ns();
     solver.solve(c.pts.data(), static_cast<int>(c.pts.size()), t, c.poses, r);
@@ -122,7 +123,9 @@ void run_chain(benchmark::State& state, const std::array<std::vector<int>, 3>& v
 }
 
 void BM_Chain_AllFound(benchmark::State& s) { run_chain(s, {}, {true, true, true}, true); }
-void BM_Chain_Hinge1(benchmark::State& s) { run_chain(s, {{{}, {}, {2}}}, {true, true, false}, true); }
+void BM_Chain_Hinge1(benchmark::State& s) {
+  run_chain(s, {{{}, {}, {2}}}, {true, true, false}, true);
+}
 void BM_Chain_Ball2Hinge1(benchmark::State& s) {
   run_chain(s, {{{}, {1, 3}, {2}}}, {true, false, false}, true);
 }

@@ -77,10 +77,17 @@ json entity(const FoxgloveScene& scene, const json& ts, const char* id) {
 
 }  // namespace
 
-std::vector<ChannelInfo> live_view_channels() {
-  return {ChannelInfo{kChannelTf, "/tf", "foxglove.FrameTransforms", frame_transforms_schema()},
-          ChannelInfo{kChannelMarkers, "/markers", "foxglove.SceneUpdate", scene_update_schema()},
-          ChannelInfo{kChannelJoints, "/joints", "mocap.JointAngles", joints_schema()}};
+std::vector<ChannelInfo> live_view_channels(const FoxgloveScene& scene) {
+  std::vector<ChannelInfo> channels = {
+      ChannelInfo{kChannelTf, "/tf", "foxglove.FrameTransforms", frame_transforms_schema()},
+      ChannelInfo{kChannelMarkers, "/markers", "foxglove.SceneUpdate", scene_update_schema()},
+      ChannelInfo{kChannelJoints, "/joints", "mocap.JointAngles", joints_schema()}};
+  for (std::size_t c = 0; c < scene.cameras.size(); ++c) {
+    channels.push_back(ChannelInfo{kChannelBlobsFirst + static_cast<std::uint32_t>(c),
+                                   "/" + scene.cameras[c].name + "/blobs", "foxglove.RawImage",
+                                   raw_image_schema()});
+  }
+  return channels;
 }
 
 std::string encode_frame_transforms(const FoxgloveScene& scene, const publish::FrameResult& frame,

@@ -10,6 +10,8 @@
 //             (body name labels), "joints" (joint centres as spheres, hinge axes as
 //             arrows, of joints whose parent body was found).
 //   /joints   mocap.JointAngles: name, type, valid, angles (rad), solved_by, sd (rad).
+//   /<camera>/blobs  foxglove.RawImage, one per stereo camera, at a low rate: the blob
+//             overlay for aiming (blob_overlay.h).
 // Timestamps: stamp_ns is the capture time on the wall clock (CLOCK_REALTIME, ns).
 #pragma once
 
@@ -26,9 +28,10 @@ namespace mocap::foxglove {
 inline constexpr std::uint32_t kChannelTf = 1;
 inline constexpr std::uint32_t kChannelMarkers = 2;
 inline constexpr std::uint32_t kChannelJoints = 3;
+inline constexpr std::uint32_t kChannelBlobsFirst = 16;  // + camera index
 
-// The advertised channels, ids as above.
-std::vector<ChannelInfo> live_view_channels();
+// The advertised channels, ids as above (a blob channel per camera of the scene).
+std::vector<ChannelInfo> live_view_channels(const FoxgloveScene& scene);
 
 std::string encode_frame_transforms(const FoxgloveScene& scene, const publish::FrameResult& frame,
                                     std::int64_t stamp_ns);

@@ -11,9 +11,11 @@
 // queues (both are "the viewer did not get this", see docs/foxglove.md).
 #include <time.h>
 
+#include <cstdint>
 #include <memory>
 #include <string>
 
+#include "pipeline/foxglove/blob_overlay.h"
 #include "pipeline/foxglove/encode.h"
 #include "pipeline/foxglove/server.h"
 #include "pipeline/publish/output_registry.h"
@@ -73,6 +75,20 @@ class FoxgloveSink final : public QueuedSink {
                          std::make_shared<const std::string>(
                              foxglove::encode_joint_angles(scene_, frame, stamp_ns)));
     }
+    // The aiming overlays, at a low rate (capture time, so a replay runs at its own pace).
+    if (frame.joints.capture_ns - last_overlay_ns_ < foxglove::kBlobOverlayPeriodNs &&
+        frame.joints.capture_ns >= last_overlay_ns_)
+      return;
+    bool sent = false;
+    for (std::size_t c = 0; c < scene_.cameras.size(); ++c) {
+      const std::uint32_t channel = foxglove::kChannelBlobsFirst + static_cast<std::uint32_t>(c);
+      if (!server_->has_subscribers(channel)) continue;
+      server_->broadcast(channel, ts,
+                         std::make_shared<const std::string>(foxglove::encode_blob_overlay(
+                             scene_, frame, static_cast<int>(c), stamp_ns)));
+      sent = true;
+    }
+    if (sent) last_overlay_ns_ = frame.joints.capture_ns;
   }
 
  private:
@@ -80,6 +96,7 @@ class FoxgloveSink final : public QueuedSink {
   std::unique_ptr<foxglove::Server> server_;
   const std::string url_;
   const std::int64_t realtime_minus_monotonic_ns_;
+  std::int64_t last_overlay_ns_ = INT64_MIN / 2;  // capture time of the last overlays sent
 };
 
 // A positive integer option (max_clients, client_queue) or the default.
@@ -121,9 +138,9 @@ Expected<OutputCreated> create_foxglove(const OutputRequest& r, const OutputCont
   auto o = options_of(r);
   if (!o) return o.error();
   if (ctx.targets == nullptr) return make_error(r.where, "", "needs the targets (none given)");
-  auto scene = foxglove::make_scene(*ctx.targets, ctx.model);
+  auto scene = foxglove::make_scene(*ctx.targets, ctx.model, ctx.rig);
   if (!scene) return scene.error();
-  auto server = foxglove::Server::create(*o, foxglove::live_view_channels());
+  auto server = foxglove::Server::create(*o, foxglove::live_view_channels(*scene));
   if (!server) {  // "foxglove: ADDR:PORT: cannot listen: ..." -> under the request's name
     std::string m = server.error().message;
     if (m.rfind("foxglove: ", 0) == 0) m.erase(0, 10);

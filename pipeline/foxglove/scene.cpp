@@ -1,6 +1,7 @@
 // Design: see scene.h.
 #include "pipeline/foxglove/scene.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace mocap::foxglove {
@@ -38,7 +39,7 @@ Rgba body_colour(int index, int count) noexcept {
 }
 
 Expected<FoxgloveScene> make_scene(const TargetSet& targets, const JointModel* model,
-                                   const std::string& world_frame) {
+                                   const Rig* rig, const std::string& world_frame) {
   const std::string where = "foxglove";
   if (world_frame.empty()) return make_error(where, "world frame", "must not be empty");
   FoxgloveScene scene;
@@ -52,6 +53,23 @@ Expected<FoxgloveScene> make_scene(const TargetSet& targets, const JointModel* m
                         "name '" + name + "' cannot be a frame id (empty or the world frame)");
     }
     scene.bodies.push_back(SceneBody{name, body_colour(i, n)});
+  }
+  if (rig != nullptr) {
+    const std::size_t stereo = std::min<std::size_t>(rig->cameras.size(), 2);
+    for (std::size_t c = 0; c < stereo; ++c) {
+      const CameraModel& cam = rig->cameras[c];
+      const bool topic_ok = !cam.name.empty() && cam.name.size() <= 64 &&
+                            cam.name.find_first_not_of(
+                                "abcdefghijklmnopqrstuvwxyz"
+                                "ABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-") == std::string::npos;
+      if (!topic_ok) {
+        return make_error(where, "rig: camera " + std::to_string(c),
+                          "name '" + cam.name + "' is not a topic name (letters, digits, _ or -)");
+      }
+      if (cam.width <= 0 || cam.height <= 0 || cam.width > 16384 || cam.height > 16384)
+        return make_error(where, "rig: camera " + cam.name, "image size out of range");
+      scene.cameras.push_back(SceneCamera{cam.name, cam.width, cam.height});
+    }
   }
   if (model == nullptr) return scene;
   for (const JointSpec& j : model->joints) {

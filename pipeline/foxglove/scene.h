@@ -1,6 +1,7 @@
 // Design: the immutable model of the Foxglove live view, built once at setup from the
-// targets and the joint model (OutputContext): body names and colours, the world frame
-// id, and each calibrated joint's centre and hinge axis in its parent body's frame. The
+// targets, the joint model and the rig (OutputContext): body names and colours, the
+// world frame id, each calibrated joint's centre and hinge axis in its parent body's
+// frame, and the stereo cameras' names and image sizes (the blob overlays). The
 // encoders (encode.h) read it, never change it. Units: the model keeps the project's
 // millimetres; the encoders convert to Foxglove's metres.
 #pragma once
@@ -9,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "camera/camera_model.h"
 #include "core/expected.h"
 #include "core/types.h"
 #include "formats/joints_yaml.h"
@@ -35,19 +37,28 @@ struct SceneJoint {
   Vec3 axis_parent = Vec3::UnitZ();  // hinge only, unit length
 };
 
+struct SceneCamera {
+  std::string name;  // topic /<name>/blobs
+  int width_px = 0;
+  int height_px = 0;
+};
+
 struct FoxgloveScene {
   std::string world_frame = "mocap";  // parent_frame_id of every body transform
   double marker_diameter_mm = 12.0;
   std::vector<SceneBody> bodies;
-  std::vector<SceneJoint> joints;  // empty without a joint model
+  std::vector<SceneJoint> joints;    // empty without a joint model
+  std::vector<SceneCamera> cameras;  // the stereo cameras; empty without a rig
 };
 
 // The colour of body i of n: evenly spaced, saturated hues (deterministic).
 Rgba body_colour(int index, int count) noexcept;
 
-// Fails with one line when a body name is empty or equals the world frame, or the model
-// names a body index outside the targets.
+// Fails with one line when a body name is empty or equals the world frame, the model
+// names a body index outside the targets, or a camera name is not a topic segment.
+// `rig` may be null (no blob overlays); its first two cameras are the stereo pair.
 Expected<FoxgloveScene> make_scene(const TargetSet& targets, const JointModel* model,
+                                   const Rig* rig = nullptr,
                                    const std::string& world_frame = "mocap");
 
 }  // namespace mocap::foxglove

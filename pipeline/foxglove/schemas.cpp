@@ -118,4 +118,19 @@ std::string joints_schema() {
       .dump();
 }
 
+std::string raw_image_schema() {
+  // Foxglove's JSON encoding carries a bytes field as a base64 string.
+  const json bytes = {{"type", "string"}, {"contentEncoding", "base64"}};
+  const json uint32 = {{"type", "integer"}, {"minimum", 0}};
+  return object_of({{"timestamp", time_schema()},
+                    {"frame_id", string()},
+                    {"width", uint32},
+                    {"height", uint32},
+                    {"encoding", string()},
+                    {"step", uint32},
+                    {"data", bytes}},
+                   "foxglove.RawImage")
+      .dump();
+}
+
 }  // namespace mocap::foxglove

@@ -1,7 +1,8 @@
 // Design: the one record of a frame's whole result that the publish stage hands to every
 // output sink (UDP, iceoryx, ROS 2, Foxglove, ...): the joint angles with validity and
-// quality (the public client::JointsMessage), the body poses, the labelled markers and
-// the 3D points. Fixed capacity and trivially copyable, so that it lives in preallocated
+// quality (the public client::JointsMessage), the body poses, the labelled markers, the
+// 3D points and each camera's blobs with what they were used for (the live view's aiming
+// overlay). Fixed capacity and trivially copyable, so that it lives in preallocated
 // publish slots and can be copied into the bounded drop-oldest queue of a slow sink
 // without allocation. Each sink encodes what it needs; names (bodies, joints, cameras)
 // are given to sinks once at setup (OutputContext in output_sink.h), not per frame.
@@ -19,12 +20,14 @@ namespace mocap::publish {
 inline constexpr int kMaxResultBodies = 16;    // = identify's kMaxBodies
 inline constexpr int kMaxResultMarkers = 256;  // labelled markers per frame
 inline constexpr int kMaxResultPoints = 256;   // 3D points per frame (= kMaxPoints)
+inline constexpr int kMaxResultCameras = 4;    // cameras with blobs (= stereo's kMaxCameras)
+inline constexpr int kMaxResultBlobs = 64;     // blobs per camera
 
 struct ResultBody {
   std::uint8_t found = 0;    // 1: the body was found in this frame
   std::uint8_t markers = 0;  // markers matched
   std::uint8_t reserved[2] = {0, 0};
-  float rms_mm = 0.0f;                                     // residual of the fit
+  float rms_mm = 0.0f;                                       // residual of the fit
   std::array<double, 4> q_world_body{{1.0, 0.0, 0.0, 0.0}};  // qw, qx, qy, qz, qw >= 0
   std::array<double, 3> t_world_body_mm{{0.0, 0.0, 0.0}};
 };
@@ -33,7 +36,7 @@ struct ResultMarker {
   std::uint8_t body = 0;    // index in targets.yaml
   std::uint8_t marker = 0;  // index in that body's target
   std::uint8_t reserved[2] = {0, 0};
-  float residual_mm = 0.0f;                     // |measured - posed model marker|
+  float residual_mm = 0.0f;                    // |measured - posed model marker|
   std::array<float, 3> X_world_mm{{0, 0, 0}};  // the measured point
 };
 
@@ -44,6 +47,30 @@ struct ResultPoint {
   std::uint8_t reserved[3] = {0, 0, 0};
 };
 
+// What a blob became in this frame.
+enum class BlobUse : std::uint8_t {
+  kUnused = 0,  // no 3D point (seen by one camera only, a stray, or rejected by stereo)
+  kPoint = 1,   // part of a triangulated 3D point that no body claimed
+  kMarker = 2,  // part of a labelled marker of a body (body, marker set)
+};
+
+struct ResultBlob {
+  float x_px = 0.0f;         // sub-pixel centroid, image pixels (column)
+  float y_px = 0.0f;         // (row)
+  float diameter_px = 0.0f;  // diameter of the disc of the blob's area
+  std::uint8_t use = 0;      // BlobUse
+  std::uint8_t body = 0;     // kMarker: index in targets.yaml
+  std::uint8_t marker = 0;   // kMarker: index in that body's target
+  std::uint8_t reserved = 0;
+};
+
+struct CameraBlobs {
+  std::int32_t count = 0;    // blobs[0, count); a camera with more keeps its first 64
+  std::uint8_t present = 0;  // 1: the camera's frame arrived
+  std::uint8_t reserved[3] = {0, 0, 0};
+  std::array<ResultBlob, kMaxResultBlobs> blobs{};
+};
+
 struct FrameResult {
   client::JointsMessage joints;  // sequence, capture/publish time, flags, angles + quality
   std::int32_t body_count = 0;
@@ -52,6 +79,8 @@ struct FrameResult {
   std::array<ResultBody, kMaxResultBodies> bodies{};
   std::array<ResultMarker, kMaxResultMarkers> markers{};
   std::array<ResultPoint, kMaxResultPoints> points{};
+  std::int32_t camera_count = 0;  // stereo cameras, rig order
+  std::array<CameraBlobs, kMaxResultCameras> cameras{};
 };
 
 static_assert(std::is_trivially_copyable_v<FrameResult>, "FrameResult lives in slots");

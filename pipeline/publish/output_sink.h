@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <string>
 
+#include "camera/camera_model.h"
 #include "formats/joints_yaml.h"
 #include "formats/targets_yaml.h"
 #include "pipeline/publish/frame_result.h"
@@ -23,6 +24,7 @@ namespace mocap::publish {
 struct OutputContext {
   const TargetSet* targets = nullptr;  // body and marker order of FrameResult
   const JointModel* model = nullptr;   // joint order of FrameResult::joints; may be null
+  const Rig* rig = nullptr;            // camera order of FrameResult::cameras; may be null
   double frame_rate_hz = 0.0;          // trigger rate, 0 if unknown
 };
 

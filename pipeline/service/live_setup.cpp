@@ -2,7 +2,6 @@
 #include "pipeline/service/live_setup.h"
 
 #include <algorithm>
-
 #include <cstring>
 
 #include "config/tracking_assets.h"
@@ -222,6 +221,7 @@ Expected<std::unique_ptr<LiveSetup>> LiveSetup::create(const config::RunConfig& 
     say(log, "note: no joint model: poses are tracked, no joint angles are sent", command);
   auto proc = FrameProcessor::create(assets->rig, assets->targets, model, cfg.tracker);
   if (!proc) return proc.error();
+  for (const std::string& w : proc->warnings()) say(log, "warning: " + w, command);
   s->processor_.emplace(std::move(proc).value());
   s->assets_ = std::move(assets).value();
   return s;

@@ -48,7 +48,8 @@ int run_calibrate(const CalibrateArgs& a) {
   copt.covariance = !a.no_refine;
   auto result = kinematics::calibrate_joints(*targets, *topology, collected->input, copt);
   if (!result) return fail(a.recording + ": " + result.error().message);
-  for (const std::string& w : result->report.warnings) std::fprintf(stderr, "mocap: warning: %s\n", w.c_str());
+  for (const std::string& w : result->report.warnings)
+    std::fprintf(stderr, "mocap: warning: %s\n", w.c_str());
   if (auto r = save_model(a.out, result->model); !r) return fail(r.error().message);
   if (!a.urdf.empty()) {
     auto r = kinematics::write_urdf(a.urdf, result->model, "mocap_robot", targets->bodies.size());
@@ -65,18 +66,22 @@ int run_calibrate(const CalibrateArgs& a) {
 
 void register_calibrate(CLI::App& app, int& exit_code) {
   auto args = std::make_shared<CalibrateArgs>();
-  CLI::App* cmd = app.add_subcommand("calibrate", "Estimate the kinematic model (ball and hinge joints) from a recording");
-  cmd->add_option("recording", args->recording, "Recording folder of the joints moving through distinct poses")->required();
+  CLI::App* cmd = app.add_subcommand(
+      "calibrate", "Estimate the kinematic model (ball and hinge joints) from a recording");
+  cmd->add_option("recording", args->recording,
+                  "Recording folder of the joints moving through distinct poses")
+      ->required();
   cmd->add_option("--targets", args->targets, "Marker targets (targets.yaml)")->required();
   cmd->add_option("--joints", args->joints, "Joint topology (joints.yaml)")->required();
   cmd->add_option("--out", args->out, "Output model (model.yaml)")->required();
   cmd->add_option("--urdf", args->urdf, "Also write a URDF of the chain");
-  cmd->add_flag("--no-refine", args->no_refine, "Linear estimates only (no Ceres refinement, no uncertainty)");
+  cmd->add_flag("--no-refine", args->no_refine,
+                "Linear estimates only (no Ceres refinement, no uncertainty)");
   cmd->add_flag("--quiet", args->quiet, "Print nothing but errors and warnings");
   cmd->callback([args, &exit_code] { exit_code = run_calibrate(*args); });
 }
 
-const CommandRegistrar kRegistrar(30, register_calibrate);
+const CommandRegistrar kCalibrateRegistrar(30, register_calibrate);
 
 }  // namespace
 }  // namespace mocap::app

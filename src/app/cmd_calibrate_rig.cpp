@@ -188,7 +188,7 @@ void register_calibrate_rig(CLI::App& app, int& exit_code) {
   cmd->callback([args, &exit_code] { exit_code = run(*args); });
 }
 
-const CommandRegistrar kRegistrar(35, register_calibrate_rig);
+const CommandRegistrar kCalibrateRigRegistrar(35, register_calibrate_rig);
 
 }  // namespace
 }  // namespace mocap::app

@@ -123,7 +123,7 @@ void register_discover(CLI::App& app, int& exit_code) {
   cmd->callback([args, &exit_code] { exit_code = run_discover(*args); });
 }
 
-const CommandRegistrar kRegistrar(32, register_discover);
+const CommandRegistrar kDiscoverRegistrar(32, register_discover);
 
 }  // namespace
 }  // namespace mocap::app

@@ -27,6 +27,7 @@
 #include "client/joints_message.h"
 #include "client/udp_receiver.h"
 #include "core/latency_stats.h"
+#include "core/units.h"
 #ifdef MOCAP_CLIENT_HAVE_ICEORYX
 #include "client/iceoryx_subscriber.h"
 #endif
@@ -50,8 +51,6 @@ struct EchoArgs {
   double duration_s = 0.0;  // 0: until SIGINT/SIGTERM
   std::string format = "text";
 };
-
-constexpr double kRadToDeg = 180.0 / M_PI;
 
 constexpr const char* kCsvHeader =
     "seq,capture_ns,age_ms,gap,flags,joint,type,valid,a0_deg,a1_deg,a2_deg,qw,qx,qy,qz,"
@@ -79,16 +78,16 @@ void print_csv(const client::JointsMessage& m, std::uint64_t gap, double age_ms,
     char tail[128] = ",,,";
     if (quality) {
       std::snprintf(tail, sizeof tail, "%s,%.6f,%.6f,%.6f", solved_by_name(q.solved_by),
-                    static_cast<double>(q.sd_rad[0]) * kRadToDeg,
-                    static_cast<double>(q.sd_rad[1]) * kRadToDeg,
-                    static_cast<double>(q.sd_rad[2]) * kRadToDeg);
+                    static_cast<double>(q.sd_rad[0]) * kDegPerRad,
+                    static_cast<double>(q.sd_rad[1]) * kDegPerRad,
+                    static_cast<double>(q.sd_rad[2]) * kDegPerRad);
     }
     std::printf("%llu,%lld,%.3f,%llu,%u,%u,%s,%u,%.6f,%.6f,%.6f,%.9f,%.9f,%.9f,%.9f,%s\n",
                 static_cast<unsigned long long>(m.sequence), static_cast<long long>(m.capture_ns),
                 age_ms, static_cast<unsigned long long>(gap), static_cast<unsigned>(m.flags),
                 static_cast<unsigned>(r.index), hinge ? "hinge" : "ball",
-                static_cast<unsigned>(r.valid), static_cast<double>(r.a[0]) * kRadToDeg,
-                static_cast<double>(r.a[1]) * kRadToDeg, static_cast<double>(r.a[2]) * kRadToDeg,
+                static_cast<unsigned>(r.valid), static_cast<double>(r.a[0]) * kDegPerRad,
+                static_cast<double>(r.a[1]) * kDegPerRad, static_cast<double>(r.a[2]) * kDegPerRad,
                 static_cast<double>(r.q[0]), static_cast<double>(r.q[1]),
                 static_cast<double>(r.q[2]), static_cast<double>(r.q[3]), tail);
   }
@@ -157,11 +156,12 @@ void print_message(const client::JointsMessage& m, std::uint64_t gap, const std:
       std::printf(" | j%u %s --", static_cast<unsigned>(r.index), hinge ? "hinge" : "ball");
     } else if (hinge) {
       std::printf(" | j%u hinge %.2f", static_cast<unsigned>(r.index),
-                  static_cast<double>(r.a[0]) * kRadToDeg);
+                  static_cast<double>(r.a[0]) * kDegPerRad);
     } else {
       std::printf(" | j%u ball %.2f %.2f %.2f", static_cast<unsigned>(r.index),
-                  static_cast<double>(r.a[0]) * kRadToDeg, static_cast<double>(r.a[1]) * kRadToDeg,
-                  static_cast<double>(r.a[2]) * kRadToDeg);
+                  static_cast<double>(r.a[0]) * kDegPerRad,
+                  static_cast<double>(r.a[1]) * kDegPerRad,
+                  static_cast<double>(r.a[2]) * kDegPerRad);
     }
   }
   std::printf(" deg\n");
@@ -279,7 +279,7 @@ void register_echo(CLI::App& app, int& exit_code) {
   cmd->callback([args, &exit_code] { exit_code = run_echo(*args); });
 }
 
-const CommandRegistrar kRegistrar(65, register_echo);
+const CommandRegistrar kEchoRegistrar(65, register_echo);
 
 }  // namespace
 }  // namespace mocap::app

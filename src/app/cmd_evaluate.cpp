@@ -175,7 +175,7 @@ void register_evaluate(CLI::App& app, int& exit_code) {
   ang->callback([args, &exit_code] { exit_code = run_angles(*args); });
 }
 
-const CommandRegistrar kRegistrar(80, register_evaluate);
+const CommandRegistrar kEvaluateRegistrar(80, register_evaluate);
 
 }  // namespace
 }  // namespace mocap::app

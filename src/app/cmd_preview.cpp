@@ -175,7 +175,7 @@ void register_preview(CLI::App& app, int& exit_code) {
   });
 }
 
-const CommandRegistrar kRegistrar(66, register_preview);
+const CommandRegistrar kPreviewRegistrar(66, register_preview);
 
 }  // namespace
 }  // namespace mocap::app

@@ -237,7 +237,7 @@ void register_record(CLI::App& app, int& exit_code) {
   });
 }
 
-const CommandRegistrar kRegistrar(65, register_record);
+const CommandRegistrar kRecordRegistrar(65, register_record);
 
 }  // namespace
 }  // namespace mocap::app

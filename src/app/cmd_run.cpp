@@ -15,8 +15,8 @@
 // --check-config FILE only validates one. Under systemd (NOTIFY_SOCKET) the supervisor of
 // pipeline/service sends READY, WATCHDOG (only while frames progress) and STATUS.
 // Structure: parse (RunArgs) -> service::resolve_run_config -> service::LiveSetup (cameras,
-// tracker, options) -> publish::create_outputs -> Pipeline::create/start -> supervise (periodic report,
-// sd_notify, stop conditions) -> report.
+// tracker, options) -> publish::create_outputs -> Pipeline::create/start -> supervise (periodic
+// report, sd_notify, stop conditions) -> report.
 #include <array>
 #include <atomic>
 #include <chrono>
@@ -30,12 +30,12 @@
 #include "app/command_registry.h"
 #include "hal/camera.h"
 #include "pipeline/pipeline.h"
+#include "pipeline/publish/output_registry.h"
 #include "pipeline/service/health_sink.h"
 #include "pipeline/service/live_setup.h"
 #include "pipeline/service/notifier.h"
 #include "pipeline/service/supervisor.h"
 #include "pipeline/stats_report.h"
-#include "pipeline/publish/output_registry.h"
 
 namespace mocap::app {
 namespace {
@@ -81,8 +81,8 @@ struct RunArgs {
   int loop_frames = 200;
   bool no_realtime = false;
   bool no_iceoryx = false;
-  bool ros2 = false;     // --ros2
-  std::string foxglove;  // --foxglove [ADDR:]PORT
+  bool ros2 = false;         // --ros2
+  std::string foxglove;      // --foxglove [ADDR:]PORT
   std::string config;        // --config FILE
   std::string check_config;  // --check-config FILE
   bool udp_given = false, rate_given = false, loop_frames_given = false;
@@ -185,6 +185,7 @@ int run_live(const RunArgs& a) {
   publish::OutputContext context;  // pointers used only while the outputs are created
   context.targets = &processor.targets();
   context.model = processor.has_model() ? &processor.model() : nullptr;
+  context.rig = &processor.rig();
   context.frame_rate_hz = opt.trigger_rate_hz;
   auto outputs = publish::create_outputs(service::output_requests(*cfg, cli), context);
   if (!outputs) return fail(outputs.error().message);
@@ -195,8 +196,7 @@ int run_live(const RunArgs& a) {
   std::vector<publish::OutputSink*> sink_list = outputs->list();
   sink_list.push_back(&health);
 
-  auto pipe =
-      pipeline::Pipeline::create(std::move(processor), (*live)->cameras(), sink_list, opt);
+  auto pipe = pipeline::Pipeline::create(std::move(processor), (*live)->cameras(), sink_list, opt);
   if (!pipe) return fail(pipe.error().message);
 
   if (g_stop_requested.load(std::memory_order_relaxed)) {
@@ -264,8 +264,9 @@ void register_run(CLI::App& app, int& exit_code) {
       ->check(CLI::Range(2, 2000));
   cmd->add_flag("--no-realtime", args->no_realtime, "No CPU pinning and no SCHED_FIFO");
   cmd->add_flag("--no-iceoryx", args->no_iceoryx, "Do not publish over iceoryx shared memory");
-  cmd->add_flag("--ros2", args->ros2,
-                "Publish /joint_states and /tf over DDS as ROS 2 does (ROS_DOMAIN_ID; docs/ros2.md)");
+  cmd->add_flag(
+      "--ros2", args->ros2,
+      "Publish /joint_states and /tf over DDS as ROS 2 does (ROS_DOMAIN_ID; docs/ros2.md)");
   cmd->add_option("--foxglove", args->foxglove,
                   "Serve the Foxglove WebSocket live view on [ADDR:]PORT (default address "
                   "127.0.0.1)");
@@ -286,7 +287,7 @@ void register_run(CLI::App& app, int& exit_code) {
   });
 }
 
-const CommandRegistrar kRegistrar(60, register_run);
+const CommandRegistrar kRunRegistrar(60, register_run);
 
 }  // namespace
 }  // namespace mocap::app

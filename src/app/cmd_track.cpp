@@ -82,7 +82,7 @@ void register_track(CLI::App& app, int& exit_code) {
   cmd->callback([args, &exit_code] { exit_code = run_track(*args); });
 }
 
-const CommandRegistrar kRegistrar(20, register_track);
+const CommandRegistrar kTrackRegistrar(20, register_track);
 
 }  // namespace
 }  // namespace mocap::app

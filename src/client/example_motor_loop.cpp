@@ -17,7 +17,7 @@
 
 namespace {
 
-constexpr float kRadToDeg = 57.29577951308232f;
+constexpr float kDegPerRad = 57.29577951308232f;
 
 void print_message(const char* source, const mocap::client::JointsMessage& m) {
   std::printf("[%s] seq %llu, %u joints%s\n", source, static_cast<unsigned long long>(m.sequence),
@@ -29,11 +29,12 @@ void print_message(const char* source, const mocap::client::JointsMessage& m) {
       std::printf("  joint %u: not tracked\n", static_cast<unsigned>(r.index));
     } else if (r.type == static_cast<std::uint8_t>(mocap::client::JointKind::kHinge)) {
       std::printf("  joint %u hinge: %8.3f deg\n", static_cast<unsigned>(r.index),
-                  static_cast<double>(r.a[0] * kRadToDeg));
+                  static_cast<double>(r.a[0] * kDegPerRad));
     } else {
       std::printf("  joint %u ball:  %8.3f %8.3f %8.3f deg\n", static_cast<unsigned>(r.index),
-                  static_cast<double>(r.a[0] * kRadToDeg), static_cast<double>(r.a[1] * kRadToDeg),
-                  static_cast<double>(r.a[2] * kRadToDeg));
+                  static_cast<double>(r.a[0] * kDegPerRad),
+                  static_cast<double>(r.a[1] * kDegPerRad),
+                  static_cast<double>(r.a[2] * kDegPerRad));
     }
   }
 }

@@ -9,12 +9,13 @@
 #include <cmath>
 #include <vector>
 
+#include "core/units.h"
 #include "discover/body_builder.h"
 #include "identify/identifier.h"
 
 namespace mocap::discover::detail {
 
-inline constexpr double kRadToDeg = 57.29577951308232;
+inline constexpr double kDegPerRad = 57.29577951308232;
 
 struct Builder {
   const std::vector<PointTrack>& tracks;
@@ -86,7 +87,7 @@ struct Builder {
     double a = 0.0;
     const int f1 = farthest(body.T_world_body[static_cast<std::size_t>(fs.front())].linear(), a);
     farthest(body.T_world_body[static_cast<std::size_t>(f1)].linear(), a);
-    return a * kRadToDeg;
+    return a * kDegPerRad;
   }
 
   // Body-frame position of track ti when it fits rigidly and informatively.

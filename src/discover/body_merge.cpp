@@ -31,7 +31,7 @@ bool same_by_poses(const Builder& A, const Builder& B, Iso3& T_ab) {
                   b.body.T_world_body[static_cast<std::size_t>(f)]);
   T_ab = rel[rel.size() / 2];
   for (const Iso3& T : rel) {
-    if (Eigen::AngleAxisd(T.linear() * T_ab.linear().transpose()).angle() * kRadToDeg > 1.0)
+    if (Eigen::AngleAxisd(T.linear() * T_ab.linear().transpose()).angle() * kDegPerRad > 1.0)
       return false;
     if ((T.translation() - T_ab.translation()).norm() > 2.0) return false;
   }
@@ -93,7 +93,7 @@ bool same_by_shape(const Builder& A, const Builder& B, Iso3& T_ab) {
   for (std::size_t f = 0; f < A.frames(); ++f) {
     if (!A.body.found[f] || !B.body.found[f]) continue;
     const Iso3 T = A.body.T_world_body[f].inverse() * B.body.T_world_body[f];
-    if (Eigen::AngleAxisd(T.linear() * T_ab.linear().transpose()).angle() * kRadToDeg > 1.0 ||
+    if (Eigen::AngleAxisd(T.linear() * T_ab.linear().transpose()).angle() * kDegPerRad > 1.0 ||
         (T.translation() - T_ab.translation()).norm() > 2.0)
       return false;
   }

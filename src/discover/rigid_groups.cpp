@@ -3,10 +3,10 @@
 #include <algorithm>
 #include <numeric>
 
+#include "core/units.h"
+
 namespace mocap::discover {
 namespace {
-
-constexpr double kRadToDeg = 57.29577951308232;
 
 double median_of(std::vector<double> v) {
   const std::size_t m = v.size() / 2;
@@ -25,7 +25,7 @@ double max_angle_deg(const std::vector<Vec3>& dirs, const Vec3& ref, std::size_t
     }
   }
   if (arg != nullptr) *arg = at;
-  return std::acos(std::clamp(-best, -1.0, 1.0)) * kRadToDeg;
+  return std::acos(std::clamp(-best, -1.0, 1.0)) * kDegPerRad;
 }
 
 // Largest deviation of a track from its median position over `frames`.

@@ -136,6 +136,16 @@ const char* joint_type_name(JointType t) noexcept {
   return t == JointType::kHinge ? "hinge" : "ball";
 }
 
+void JointSpec::set_extra(const std::string& key, std::vector<double> values) {
+  for (auto& [k, v] : extra) {
+    if (k == key) {
+      v = std::move(values);
+      return;
+    }
+  }
+  extra.emplace_back(key, std::move(values));
+}
+
 int JointModel::index_of(const std::string& name) const noexcept {
   for (std::size_t i = 0; i < joints.size(); ++i) {
     if (joints[i].name == name) return static_cast<int>(i);

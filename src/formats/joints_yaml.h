@@ -36,6 +36,8 @@ struct JointSpec {
   // Optional extra numeric keys of model.yaml (e.g. "residual_rms_mm": [0.4],
   // "center_parent_std_mm": [...]), written and read back in order.
   std::vector<std::pair<std::string, std::vector<double>>> extra;
+  // Sets (replaces or appends) the extra key.
+  void set_extra(const std::string& key, std::vector<double> values);
 };
 
 struct JointModel {

@@ -7,12 +7,12 @@
 #include <cmath>
 #include <limits>
 
+#include "core/units.h"
 #include "identify/rigid_fit.h"
 
 namespace mocap {
 namespace {
 enum : std::uint8_t { kPending, kWarm, kWarmConflict, kDone, kFound, kFoundWarm };
-constexpr double kRadToDeg = 57.29577951308232;
 }  // namespace
 
 Expected<Identifier> Identifier::create(const TargetSet& targets, const IdentifyConfig& config) {
@@ -77,7 +77,8 @@ bool Identifier::within_speed_limits(const Track& tr, const Iso3& T,
     return false;
   if (config_.max_angular_speed_deg_per_s > 0.0) {
     const Eigen::AngleAxisd dR(T.linear() * tr.T_last.linear().transpose());
-    if (std::abs(dR.angle()) * kRadToDeg / dt_s > config_.max_angular_speed_deg_per_s) return false;
+    if (std::abs(dR.angle()) * kDegPerRad / dt_s > config_.max_angular_speed_deg_per_s)
+      return false;
   }
   return true;
 }

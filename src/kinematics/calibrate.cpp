@@ -13,20 +13,10 @@
 namespace mocap::kinematics {
 namespace {
 
-std::string num(double v) {
+std::string num3(double v) {
   char buf[32];
   std::snprintf(buf, sizeof(buf), "%.3g", v);
   return buf;
-}
-
-void set_extra(JointSpec& s, const std::string& key, std::vector<double> values) {
-  for (auto& [k, v] : s.extra) {
-    if (k == key) {
-      v = std::move(values);
-      return;
-    }
-  }
-  s.extra.emplace_back(key, std::move(values));
 }
 
 std::string label_of(const JointSpec& s) {
@@ -74,8 +64,8 @@ void check_lever(const JointSpec& s, const CalibrationOptions& options,
   const double lp = s.center_parent.cross(s.axis_parent).norm();
   const double lc = s.center_child.cross(s.axis_child).norm();
   if (std::min(lp, lc) < options.min_axis_lever_mm) {
-    warnings.push_back(label_of(s) + ": the axis passes " + num(std::min(lp, lc)) +
-                       " mm from a body origin (< " + num(options.min_axis_lever_mm) +
+    warnings.push_back(label_of(s) + ": the axis passes " + num3(std::min(lp, lc)) +
+                       " mm from a body origin (< " + num3(options.min_axis_lever_mm) +
                        " mm): the zero of the hinge angle (frame C) is poorly defined");
   }
 }
@@ -121,11 +111,10 @@ Expected<CalibrationResult> calibrate_joints(const TargetSet& targets, const Joi
       jr.linear = est->diagnostics;
     }
     s.calibrated = true;
-    set_extra(s, "frames_used", {static_cast<double>(jr.frames_used)});
-    set_extra(
-        s, "linear_singular_values",
-        std::vector<double>(jr.linear.singular_values.begin(), jr.linear.singular_values.end()));
-    set_extra(s, "linear_residual_rms_mm", {jr.linear.residual_rms_mm});
+    s.set_extra("frames_used", {static_cast<double>(jr.frames_used)});
+    s.set_extra("linear_singular_values", std::vector<double>(jr.linear.singular_values.begin(),
+                                                              jr.linear.singular_values.end()));
+    s.set_extra("linear_residual_rms_mm", {jr.linear.residual_rms_mm});
     report.joints.push_back(jr);
   }
 
@@ -153,7 +142,7 @@ Expected<CalibrationResult> calibrate_joints(const TargetSet& targets, const Joi
     result.model = std::move(ref->model);
     for (std::size_t j = 0; j < result.model.joints.size(); ++j) {
       report.joints[j].residual_rms_mm = ref->joint_rms_mm[j];
-      set_extra(result.model.joints[j], "residual_rms_mm", {ref->joint_rms_mm[j]});
+      result.model.joints[j].set_extra("residual_rms_mm", {ref->joint_rms_mm[j]});
     }
     report.bodies = std::move(ref->bodies);
     report.refine_frames = ref->frames;
@@ -168,7 +157,7 @@ Expected<CalibrationResult> calibrate_joints(const TargetSet& targets, const Joi
 
 std::string format_report(const CalibrationResult& result) {
   auto v3 = [](const Vec3& v) {
-    return "[" + num(v[0]) + ", " + num(v[1]) + ", " + num(v[2]) + "]";
+    return "[" + num3(v[0]) + ", " + num3(v[1]) + ", " + num3(v[2]) + "]";
   };
   std::string s;
   const auto& r = result.report;
@@ -185,17 +174,17 @@ std::string format_report(const CalibrationResult& result) {
     for (const auto& [key, values] : js.extra) {
       if (key == "linear_singular_values") continue;
       s += "  " + key + ":";
-      for (double x : values) s += " " + num(x);
+      for (double x : values) s += " " + num3(x);
       s += "\n";
     }
   }
   for (const auto& b : r.bodies) {
-    s += "body " + b.body + ": residual rms " + num(b.rms_mm) + " mm, max " + num(b.max_mm) +
+    s += "body " + b.body + ": residual rms " + num3(b.rms_mm) + " mm, max " + num3(b.max_mm) +
          " mm over " + std::to_string(b.observations) + " markers\n";
   }
   if (r.refine_frames > 0) {
     s += "refinement: " + std::to_string(r.refine_frames) + " frames, " +
-         std::to_string(r.refine_iterations) + " iterations, " + num(r.refine_seconds) + " s\n";
+         std::to_string(r.refine_iterations) + " iterations, " + num3(r.refine_seconds) + " s\n";
   }
   for (const auto& w : r.warnings) s += "warning: " + w + "\n";
   return s;

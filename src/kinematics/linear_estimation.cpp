@@ -8,10 +8,10 @@
 #include <cstdio>
 #include <numbers>
 
+#include "core/units.h"
+
 namespace mocap::kinematics {
 namespace {
-
-constexpr double kRadToDeg = 180.0 / std::numbers::pi;
 
 std::string g3(double a) {
   char buf[64];
@@ -104,7 +104,7 @@ std::string check_count(int n, const LinearOptions& options, const std::string& 
 }  // namespace
 
 double LinearDiagnostics::singular_value_deg(int k) const noexcept {
-  return singular_values[static_cast<std::size_t>(k)] * kRadToDeg;
+  return singular_values[static_cast<std::size_t>(k)] * kDegPerRad;
 }
 
 std::string LinearDiagnostics::describe() const {
@@ -123,8 +123,7 @@ RelativePose relative_pose(const Iso3& T_world_parent, const Iso3& T_world_child
 
 // The paper's Eq. 2 system [I  -R_i] [c_p; c_c] = t_i over the relative poses; an
 // empty string on success, else the one-line error.
-static std::string build_eq2(const std::vector<RelativePose>& poses,
-                             const LinearOptions& options,
+static std::string build_eq2(const std::vector<RelativePose>& poses, const LinearOptions& options,
                              const std::string& label, Eigen::MatrixXd& A, Eigen::VectorXd& b) {
   const int n = static_cast<int>(poses.size());
   if (auto e = check_count(n, options, label); !e.empty()) return e;

@@ -13,6 +13,7 @@
 #include <memory>
 
 #include "core/rotation.h"
+#include "core/units.h"
 #include "kinematics/joint_frame.h"
 
 namespace mocap::kinematics {
@@ -104,23 +105,13 @@ void set_quat(double* q, const Mat3& R) {
   q[3] = e.z();
 }
 
-void set_extra(JointSpec& s, const std::string& key, std::vector<double> values) {
-  for (auto& [k, v] : s.extra) {
-    if (k == key) {
-      v = std::move(values);
-      return;
-    }
-  }
-  s.extra.emplace_back(key, std::move(values));
-}
-
 // Square root of the largest eigenvalue of a symmetric covariance.
 double max_std(const Mat3& C) {
   const Mat3 S = 0.5 * (C + C.transpose());
   return std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Mat3>(S).eigenvalues().maxCoeff()));
 }
 
-std::string num(double v) {
+std::string num4(double v) {
   char buf[32];
   std::snprintf(buf, sizeof(buf), "%.4g", v);
   return buf;
@@ -340,7 +331,7 @@ Expected<RefinementOutput> refine_joints(const TargetSet& targets, const JointMo
   if (outliers * 100 > static_cast<int>(blocks.size())) {
     out.warnings.push_back("calibration: " + std::to_string(outliers) + " of " +
                            std::to_string(blocks.size()) + " marker residuals exceed " +
-                           num(3.0 * options.huber_mm) + " mm (outliers or a wrong joint type)");
+                           num4(3.0 * options.huber_mm) + " mm (outliers or a wrong joint type)");
   }
 
   // Refined parameters back into the model.
@@ -388,7 +379,6 @@ Expected<RefinementOutput> refine_joints(const TargetSet& targets, const JointMo
           "calibration: covariance not computed (rank-deficient Jacobian: a parameter is not "
           "determined by the data); no uncertainties written");
     } else {
-      constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
       for (std::size_t j = 0; j < nj; ++j) {
         JointSpec& s = out.model.joints[j];
         const JointParams& g = jp[j];
@@ -401,8 +391,8 @@ Expected<RefinementOutput> refine_joints(const TargetSet& targets, const JointMo
           Cc *= sigma2;
           const Vec3 sp = Cp.diagonal().cwiseMax(0.0).cwiseSqrt();
           const Vec3 sc = Cc.diagonal().cwiseMax(0.0).cwiseSqrt();
-          set_extra(s, "center_parent_std_mm", std::vector<double>{sp[0], sp[1], sp[2]});
-          set_extra(s, "center_child_std_mm", std::vector<double>{sc[0], sc[1], sc[2]});
+          s.set_extra("center_parent_std_mm", std::vector<double>{sp[0], sp[1], sp[2]});
+          s.set_extra("center_child_std_mm", std::vector<double>{sc[0], sc[1], sc[2]});
         } else {
           // Ambient 3x3 covariance of the unit axis (the manifold's Plus Jacobian maps the
           // tangent covariance); for a unit vector its largest eigenvalue is the variance
@@ -410,14 +400,14 @@ Expected<RefinementOutput> refine_joints(const TargetSet& targets, const JointMo
           Mat3 Ap, Ac;
           cov.GetCovarianceBlock(g.a_p, g.a_p, Ap.data());
           cov.GetCovarianceBlock(g.a_c, g.a_c, Ac.data());
-          const double ap_deg = max_std(sigma2 * Ap) * kRadToDeg;
-          const double ac_deg = max_std(sigma2 * Ac) * kRadToDeg;
+          const double ap_deg = max_std(sigma2 * Ap) * kDegPerRad;
+          const double ac_deg = max_std(sigma2 * Ac) * kDegPerRad;
           const Mat3 P = Mat3::Identity() - s.axis_parent * s.axis_parent.transpose();
           const Mat3 Cperp = P * Cp * P;
           const double pos_mm = max_std(Cperp);
-          set_extra(s, "axis_parent_std_deg", std::vector<double>{ap_deg});
-          set_extra(s, "axis_child_std_deg", std::vector<double>{ac_deg});
-          set_extra(s, "axis_position_std_mm", std::vector<double>{pos_mm});
+          s.set_extra("axis_parent_std_deg", std::vector<double>{ap_deg});
+          s.set_extra("axis_child_std_deg", std::vector<double>{ac_deg});
+          s.set_extra("axis_position_std_mm", std::vector<double>{pos_mm});
         }
       }
     }

@@ -10,12 +10,12 @@
 #include <numbers>
 
 #include "core/rotation.h"
+#include "core/units.h"
 #include "sim/sim_rng.h"
 
 namespace mocap::sim {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
 
 double halton(int index, int base) {
@@ -33,8 +33,8 @@ double halton(int index, int base) {
 // targets in view. (With the elbow at 60 deg two lower-arm markers overlap in camera 1.)
 JointConfig fixed_pose() {
   JointConfig c;
-  c.shoulder_rad = Vec3(-27.5, -38.0, -24.0) * kDeg;
-  c.elbow_rad = 23.0 * kDeg;
+  c.shoulder_rad = Vec3(-27.5, -38.0, -24.0) * kRadPerDeg;
+  c.elbow_rad = 23.0 * kRadPerDeg;
   return c;
 }
 
@@ -52,8 +52,8 @@ void plan_smooth(const MotionSpec& spec, MotionPlan& plan) {
     c.shoulder_rad = Vec3(-25.0 + 40.0 * std::sin(kTwoPi * hz[0] * t + 0.3),
                           -28.0 + 26.0 * std::sin(kTwoPi * hz[1] * t + 1.1),
                           35.0 * std::sin(kTwoPi * hz[2] * t + 2.0)) *
-                     kDeg;
-    c.elbow_rad = (60.0 + 50.0 * std::sin(kTwoPi * hz[3] * t - 0.5)) * kDeg;
+                     kRadPerDeg;
+    c.elbow_rad = (60.0 + 50.0 * std::sin(kTwoPi * hz[3] * t - 0.5)) * kRadPerDeg;
     plan.configs.push_back(c);
   }
   plan.segments.push_back(MotionSegment{"move", 0, spec.frames - 1, Vec3::Zero()});
@@ -69,8 +69,8 @@ void plan_poses(const MotionSpec& spec, MotionPlan& plan) {
     c.shoulder_rad =
         Vec3(-70.0 + 85.0 * halton(k + 1, 2) + j0, -58.0 + 60.0 * halton(k + 1, 3) + j1,
              -40.0 + 80.0 * halton(k + 1, 5) + j2) *
-        kDeg;
-    c.elbow_rad = (8.0 + 105.0 * halton(k + 1, 7) + j3) * kDeg;
+        kRadPerDeg;
+    c.elbow_rad = (8.0 + 105.0 * halton(k + 1, 7) + j3) * kRadPerDeg;
     poses.push_back(c);
   }
   for (int f = 0; f < spec.frames; ++f) {
@@ -124,9 +124,9 @@ void plan_viewpoints(const SimScene& scene, const MotionSpec& spec, MotionPlan& 
   const Vec3 c = scene.robot_center_world;
   for (int f = 0; f < spec.frames; ++f) {
     const double x = spec.frames > 1 ? static_cast<double>(f) / (spec.frames - 1) : 0.0;
-    const double yaw = 55.0 * std::sin(kTwoPi * 1.0 * x) * kDeg;
-    const double pitch = 20.0 * std::sin(kTwoPi * 0.7 * x + 0.8) * kDeg;
-    const double roll = 10.0 * std::sin(kTwoPi * 1.3 * x + 2.1) * kDeg;
+    const double yaw = 55.0 * std::sin(kTwoPi * 1.0 * x) * kRadPerDeg;
+    const double pitch = 20.0 * std::sin(kTwoPi * 0.7 * x + 0.8) * kRadPerDeg;
+    const double roll = 10.0 * std::sin(kTwoPi * 1.3 * x + 2.1) * kRadPerDeg;
     const Vec3 shift(60.0 * std::sin(kTwoPi * 0.5 * x), 120.0 * std::sin(kTwoPi * 0.9 * x + 1.0),
                      40.0 * std::sin(kTwoPi * 1.1 * x));
     const Mat3 R = rot_z(yaw) * rot_x(pitch) * rot_y(roll);

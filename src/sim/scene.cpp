@@ -10,16 +10,16 @@
 #include <string>
 
 #include "core/rotation.h"
+#include "core/units.h"
 #include "sim/scene_rig.h"
 #include "sim/sim_rng.h"
 
 namespace mocap::sim {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
-
-CameraModel make_camera(const std::string& name, double x_mm, double fx, double fy, double cx,
-                        double cy, const std::array<double, 5>& dist, double roll_deg) {
+CameraModel make_camera(const std::string& name, double x_mm, const CameraMount& mount, double fx,
+                        double fy, double cx, double cy, const std::array<double, 5>& dist,
+                        double roll_deg) {
   CameraModel cam;
   cam.name = name;
   cam.width = 1032;
@@ -29,8 +29,8 @@ CameraModel make_camera(const std::string& name, double x_mm, double fx, double 
   cam.cx = cx;
   cam.cy = cy;
   cam.distortion = dist;
-  const Vec3 center(x_mm, -1000.0, 30.0);
-  const Vec3 aim(0.0, 250.0, 0.0);  // optical axes cross 1.25 m in front of the baseline
+  const Vec3 center(mount.x_mm + x_mm, mount.y_mm, mount.z_mm);
+  const Vec3 aim(mount.x_mm, 250.0, mount.aim_z_mm);  // where the optical axes cross
   const Vec3 z = (aim - center).normalized();
   const Vec3 x = z.cross(Vec3::UnitZ()).normalized();
   const Vec3 y = z.cross(x);
@@ -38,7 +38,7 @@ CameraModel make_camera(const std::string& name, double x_mm, double fx, double 
   R.row(0) = x.transpose();
   R.row(1) = y.transpose();
   R.row(2) = z.transpose();
-  R = rot_z(roll_deg * kDeg) * R;  // a small mounting roll about the optical axis
+  R = rot_z(roll_deg * kRadPerDeg) * R;  // a small mounting roll about the optical axis
   cam.R_cam_world = R;
   cam.t_cam_world = -R * center;
   return cam;
@@ -50,7 +50,7 @@ struct Limb {
 };
 
 Vec3 radial_dir(double phi_deg) {
-  return Vec3(std::sin(phi_deg * kDeg), -std::cos(phi_deg * kDeg), 0.0);
+  return Vec3(std::sin(phi_deg * kRadPerDeg), -std::cos(phi_deg * kRadPerDeg), 0.0);
 }
 
 }  // namespace
@@ -90,16 +90,17 @@ Expected<SimScene> build_shoulder_scene(const SceneOptions& options) {
   scene.imaging = im;
   scene.marker_radius_mm = 6.0;
   scene.kind = options.kind;
-  scene.rig.cameras.push_back(make_camera("cam0", -238.5, 1291.2, 1290.6, 517.3, 385.9,
+  const CameraMount mount = camera_mount(options.kind);
+  scene.rig.cameras.push_back(make_camera("cam0", -238.5, mount, 1291.2, 1290.6, 517.3, 385.9,
                                           {-0.121, 0.083, 0.0004, -0.0003, 0.0}, 0.3));
-  scene.rig.cameras.push_back(make_camera("cam1", 238.5, 1288.7, 1288.1, 513.8, 389.4,
+  scene.rig.cameras.push_back(make_camera("cam1", 238.5, mount, 1288.7, 1288.1, 513.8, 389.4,
                                           {-0.118, 0.079, -0.0002, 0.0005, 0.0}, -0.4));
 
   // Body frames at the reference configuration (deliberately rotated).
   scene.T_world_body_ref = {
-      make_iso(rot_z(10.0 * kDeg), Vec3(-170.0, 60.0, 40.0)),
-      make_iso(rot_z(-15.0 * kDeg) * rot_x(5.0 * kDeg), Vec3(-60.0, 40.0, 50.0)),
-      make_iso(rot_y(20.0 * kDeg) * rot_z(30.0 * kDeg), Vec3(-60.0, 40.0, -140.0))};
+      make_iso(rot_z(10.0 * kRadPerDeg), Vec3(-170.0, 60.0, 40.0)),
+      make_iso(rot_z(-15.0 * kRadPerDeg) * rot_x(5.0 * kRadPerDeg), Vec3(-60.0, 40.0, 50.0)),
+      make_iso(rot_y(20.0 * kRadPerDeg) * rot_z(30.0 * kRadPerDeg), Vec3(-60.0, 40.0, -140.0))};
   const Vec3 shoulder_world(-60.0, 40.0, 150.0);
   const Vec3 elbow_world(-60.0, 40.0, -50.0);
   const Vec3 elbow_axis_world(-1.0, 0.0,

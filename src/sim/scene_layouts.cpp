@@ -1,6 +1,6 @@
 // Design: see scene_layouts.h. The numbers of both layouts; docs/simulator.md has the
 // table and a drawing. The limbs layout was found by a seeded search over heights, gaps
-// and azimuths (torso within +-15 deg of -120, -80, -40, 0, 40, 170; upper arm within
+// and azimuths (torso within +-8 deg of -45, -20, 5, 30, 55; upper arm within
 // +-10 deg of -55, -20, 15, 50, 85, 150; lower arm within +-10 deg of -45, -5, 35, 75,
 // 160; heights at least 20 mm apart) maximising the distinctness of inter-marker
 // distances and triangles.
@@ -38,12 +38,11 @@ const MarkerLayout& marker_layout(SceneKind kind) {
       2.0};
   // A lab's layout: balls along and around each limb on 2 mm-radius bases of 3..5 mm.
   static const MarkerLayout limbs{{{
-                                      {{98.0, 10.0, 4.0},
-                                       {43.5, 30.9, 5.0},
-                                       {23.0, -113.3, 4.0},
-                                       {-19.5, -70.0, 4.0},
-                                       {-44.2, 180.0, 3.0},
-                                       {-100.0, -35.5, 3.0}},
+                                      {{105.0, 5.6, 4.0},
+                                       {60.0, 61.9, 4.0},
+                                       {-45.0, 31.6, 5.0},
+                                       {-57.0, -25.7, 4.0},
+                                       {-106.0, -37.3, 3.0}},
                                       {{122.0, -45.0, 4.0},
                                        {93.9, 20.3, 3.0},
                                        {73.4, 140.0, 3.0},
@@ -58,6 +57,11 @@ const MarkerLayout& marker_layout(SceneKind kind) {
                                   }},
                                   2.0};
   return kind == SceneKind::kStalks ? stalks : limbs;
+}
+
+CameraMount camera_mount(SceneKind kind) noexcept {
+  if (kind == SceneKind::kStalks) return CameraMount{0.0, -1000.0, 30.0, 0.0};
+  return CameraMount{-150.0, -1100.0, 900.0, -200.0};
 }
 
 }  // namespace mocap::sim

@@ -11,6 +11,7 @@
 #include <cstdio>
 
 #include "core/rotation.h"
+#include "core/units.h"
 #include "formats/csv_outputs.h"
 #include "formats/joints_yaml.h"
 #include "formats/pgm.h"
@@ -23,8 +24,6 @@
 
 namespace mocap::sim {
 namespace {
-
-constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
 
 Quat hinge_zero(const JointSpec& joint) {
   for (const auto& [key, values] : joint.extra) {
@@ -172,7 +171,7 @@ Expected<SimSummary> write_simulated_recording(const SimOptions& options, const 
       row.timestamp_ns = ts;
       row.joint = j.name;
       row.type = j.type;
-      row.angles_deg = joint_angles_rad(j, Tp, Tc) * kRadToDeg;
+      row.angles_deg = joint_angles_rad(j, Tp, Tc) * kDegPerRad;
       row.q_parent_child = canonical_quat(Tp.linear().transpose() * Tc.linear());
       row.solved_by = "truth";  // ground truth: exact, sd 0
       write_row(*angles_csv, row);

@@ -12,6 +12,7 @@
 #include <numbers>
 
 #include "core/rotation.h"
+#include "core/units.h"
 #include "formats/csv_outputs.h"
 #include "formats/pgm.h"
 #include "formats/recording.h"
@@ -24,7 +25,6 @@ namespace mocap::sim {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
-constexpr double kDeg = kPi / 180.0;
 
 // Room glints: static shiny spots behind the volume, facing the cameras roughly.
 void add_room_glints(SimScene& scene, int count, std::uint64_t seed) {
@@ -111,7 +111,7 @@ CalibrationObjects default_calibration_objects() {
 }
 
 Iso3 simulated_T_world_lframe() {
-  return make_iso(rot_z(12.0 * kDeg), Vec3(-170.0, 130.0, -215.0));
+  return make_iso(rot_z(12.0 * kRadPerDeg), Vec3(-170.0, 130.0, -215.0));
 }
 
 Rig rig_in_lframe(const Rig& rig, const Iso3& T_world_lframe) {

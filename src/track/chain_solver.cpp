@@ -6,12 +6,12 @@
 #include <cmath>
 #include <numbers>
 
+#include "core/units.h"
 #include "identify/consistency.h"
 
 namespace mocap {
 namespace {
 
-constexpr double kDegToRad = std::numbers::pi / 180.0;
 using MatX = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxChainDof, kMaxChainDof>;
 using VecX = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxChainDof, 1>;
 
@@ -52,7 +52,7 @@ Expected<ChainSolver> ChainSolver::create(ChainModel model, const ChainConfig& c
 
 ChainSolver::ChainSolver(ChainModel model, const ChainConfig& config)
     : model_(std::move(model)), config_(config) {
-  max_rate_rad_per_s_ = config_.max_angular_speed_deg_per_s * kDegToRad;
+  max_rate_rad_per_s_ = config_.max_angular_speed_deg_per_s * kRadPerDeg;
   priors_.assign(static_cast<std::size_t>(model_.joint_count()), Prior{});
 }
 
@@ -111,8 +111,8 @@ bool ChainSolver::gauss_newton(const MeasuredPoint* pts, const BodyPoses& poses,
       int depth = 0;
       for (int jj = model_.joint_into(b); jj >= 0 && active_[static_cast<std::size_t>(jj)];
            jj = model_.joint_into(model_.joint(jj).parent)) {
-        path[static_cast<std::size_t>(depth++)] = Block{dof_offset_[static_cast<std::size_t>(jj)],
-                                                        model_.joint(jj).dof, Mat3::Zero()};
+        path[static_cast<std::size_t>(depth++)] =
+            Block{dof_offset_[static_cast<std::size_t>(jj)], model_.joint(jj).dof, Mat3::Zero()};
       }
       for (std::size_t m = 0; m < markers.size(); ++m) {
         const int p = out.point_index_of_marker[ub][m];
@@ -177,8 +177,8 @@ bool ChainSolver::gauss_newton(const MeasuredPoint* pts, const BodyPoses& poses,
     for (std::size_t m = 0; m < markers.size(); ++m) {
       const int p = out.point_index_of_marker[ub][m];
       if (p >= 0)
-        chi2_ += (out.T_world_body[ub] * markers[m] - pts[p].X_world).squaredNorm() /
-                 sigma_sq(pts[p]);
+        chi2_ +=
+            (out.T_world_body[ub] * markers[m] - pts[p].X_world).squaredNorm() / sigma_sq(pts[p]);
     }
   }
   dof_ = 3 * residual_markers_ - ndof;

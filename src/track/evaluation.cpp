@@ -11,16 +11,15 @@
 #include <sstream>
 
 #include "core/rotation.h"
+#include "core/units.h"
 
 namespace mocap {
 namespace {
 
-constexpr double kRadToDeg = 180.0 / M_PI;
-
 double angle_between_lines_deg(const Vec3& a, const Vec3& b) {
   const double c = std::abs(a.normalized().dot(b.normalized()));
   const double s = a.normalized().cross(b.normalized()).norm();
-  return std::atan2(s, c) * kRadToDeg;
+  return std::atan2(s, c) * kDegPerRad;
 }
 
 // Distance of `p` from the line through `c` with direction `d`.
@@ -30,7 +29,7 @@ double point_line_distance(const Vec3& p, const Vec3& c, const Vec3& d) {
 
 double geodesic_deg(const Quat& a, const Quat& b) {
   const double d = std::min(1.0, std::abs(a.normalized().dot(b.normalized())));
-  return 2.0 * std::acos(d) * kRadToDeg;
+  return 2.0 * std::acos(d) * kDegPerRad;
 }
 
 Quat mean_rotation(const std::vector<Quat>& qs) {

@@ -61,6 +61,11 @@ Expected<FrameProcessor> FrameProcessor::create(const Rig& rig, const TargetSet&
     if (!chain) return Error{"chain tracking: " + chain.error().message};
     p.chain_.emplace(std::move(chain).value());
   }
+  p.warnings_ = p.identifier_.warnings();
+  if (p.chain_) {
+    for (const std::string& w : p.chain_->model().warnings())
+      p.warnings_.push_back("chain tracking: " + w);
+  }
   for (auto& c : p.centroids_px_) c.resize(static_cast<std::size_t>(config.detect.max_blobs));
   p.measured_.resize(static_cast<std::size_t>(std::max(1, config.stereo.max_candidates)));
   p.body_views_.resize(targets.bodies.size());
@@ -161,7 +166,8 @@ bool FrameProcessor::process_blobs(std::int64_t timestamp_ns, FrameOutput& out) 
     }
     angles_->compute(body_views_.data(), out.angles);
     if (chain_) {
-      for (std::size_t j = 0; j < out.angles.joints.size() && j < chain_result_.joints.size(); ++j) {
+      for (std::size_t j = 0; j < out.angles.joints.size() && j < chain_result_.joints.size();
+           ++j) {
         kinematics::JointAngle& a = out.angles.joints[j];
         if (!a.valid) continue;
         a.solved_by = chain_result_.joints[j].solved_by;

@@ -114,7 +114,9 @@ class FrameProcessor {
   const ChainCounters* chain_counters() const noexcept {
     return chain_ ? &chain_->counters() : nullptr;
   }
-  const std::vector<std::string>& warnings() const noexcept { return identifier_.warnings(); }
+  // Setup warnings, one line each: the identifier's (ambiguous targets) and the chain
+  // model's (joints left out of chain tracking).
+  const std::vector<std::string>& warnings() const noexcept { return warnings_; }
 
  private:
   FrameProcessor(Rig rig, TargetSet targets, JointModel model,
@@ -136,6 +138,7 @@ class FrameProcessor {
   std::optional<kinematics::JointAngleSolver> angles_;
   std::optional<ChainSolver> chain_;
   ChainResult chain_result_;
+  std::vector<std::string> warnings_;
   // Workspace, sized at create().
   std::array<std::vector<Vec2>, 2> centroids_px_;
   std::vector<MeasuredPoint> measured_;

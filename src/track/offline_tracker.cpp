@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "core/rotation.h"
+#include "core/units.h"
 #include "formats/csv_outputs.h"
 #include "formats/joints_yaml.h"
 #include "formats/recording.h"
@@ -13,11 +14,7 @@
 #include "track/trajectory_export.h"
 
 namespace mocap {
-namespace {
-
-constexpr double kRadToDeg = 180.0 / M_PI;
-
-}  // namespace
+namespace {}  // namespace
 
 Expected<OfflineTrackResult> track_recording(const OfflineTrackOptions& opt) {
   auto rec = Recording::open(opt.recording_dir);
@@ -33,7 +30,8 @@ Expected<OfflineTrackResult> track_recording(const OfflineTrackOptions& opt) {
   auto proc = FrameProcessor::create(rec->rig(), *targets, model ? &*model : nullptr, opt.config);
   if (!proc) {  // name the file the problem comes from (the spec's "file: key: problem")
     const std::string& m = proc.error().message;
-    if (m.rfind("rig: ", 0) == 0) return make_error(opt.recording_dir + "/rig.yaml", "cameras", m.substr(5));
+    if (m.rfind("rig: ", 0) == 0)
+      return make_error(opt.recording_dir + "/rig.yaml", "cameras", m.substr(5));
     if (m.rfind("identification: ", 0) == 0) return make_error(opt.targets_path, "", m);
     if (m.rfind("joint angles: ", 0) == 0 || m.rfind("chain tracking: ", 0) == 0)
       return make_error(opt.model_path, "", m);
@@ -86,7 +84,9 @@ Expected<OfflineTrackResult> track_recording(const OfflineTrackOptions& opt) {
       auto loaded = rec->load_frame(c, fe.frame, images[static_cast<std::size_t>(c)]);
       if (!loaded) {
         damaged = true;
-        if (opt.warn) opt.warn(loaded.error().message + " (frame " + std::to_string(fe.frame) + " treated as dropped)");
+        if (opt.warn)
+          opt.warn(loaded.error().message + " (frame " + std::to_string(fe.frame) +
+                   " treated as dropped)");
       } else if (*loaded == FrameLoad::kMissing) {
         missing = true;
       } else {
@@ -132,21 +132,22 @@ Expected<OfflineTrackResult> track_recording(const OfflineTrackOptions& opt) {
         angle_row.timestamp_ns = fe.timestamp_ns;
         angle_row.joint = model->joints[j].name;
         angle_row.type = a.type;
-        angle_row.angles_deg = Vec3(a.a0, a.a1, a.a2) * kRadToDeg;
+        angle_row.angles_deg = Vec3(a.a0, a.a1, a.a2) * kDegPerRad;
         angle_row.q_parent_child = a.q_parent_child;
         angle_row.solved_by = client::solved_by_name(a.solved_by);
         if (a.solved_by == client::SolvedBy::kChain)
           ++result.joint_chain[j];
         else
           ++result.joint_poses[j];
-        angle_row.sd_deg = Vec3(a.sd_rad[0], a.sd_rad[1], a.sd_rad[2]) * kRadToDeg;
+        angle_row.sd_deg = Vec3(a.sd_rad[0], a.sd_rad[1], a.sd_rad[2]) * kDegPerRad;
         write_row(*angles_csv, angle_row);
         ++result.angle_rows;
       }
     }
     label_markers(out, *targets, *labelled);
     if (!exports->write_frame(fi, *labelled)) break;  // close() below names the file
-    if (opt.progress) opt.progress(static_cast<std::int64_t>(fi + 1), static_cast<std::int64_t>(frames.size()));
+    if (opt.progress)
+      opt.progress(static_cast<std::int64_t>(fi + 1), static_cast<std::int64_t>(frames.size()));
   }
 
   if (auto r = points_csv->close(); !r) return r.error();
@@ -181,14 +182,18 @@ Expected<OfflineTrackResult> track_recording(const OfflineTrackOptions& opt) {
 std::string format_track_summary(const OfflineTrackResult& r) {
   std::string s;
   char buf[256];
-  std::snprintf(buf, sizeof buf, "tracked %lld frames (%lld with a missing camera frame, %lld damaged), %lld 3D points\n",
-                static_cast<long long>(r.frames), static_cast<long long>(r.frames_missing),
-                static_cast<long long>(r.frames_damaged), static_cast<long long>(r.points));
+  std::snprintf(
+      buf, sizeof buf,
+      "tracked %lld frames (%lld with a missing camera frame, %lld damaged), %lld 3D points\n",
+      static_cast<long long>(r.frames), static_cast<long long>(r.frames_missing),
+      static_cast<long long>(r.frames_damaged), static_cast<long long>(r.points));
   s += buf;
   for (std::size_t b = 0; b < r.body_names.size(); ++b) {
-    std::snprintf(buf, sizeof buf, "  %-10s found in %lld frames (%.1f%%)\n", r.body_names[b].c_str(),
-                  static_cast<long long>(r.body_found[b]),
-                  r.frames ? 100.0 * static_cast<double>(r.body_found[b]) / static_cast<double>(r.frames) : 0.0);
+    std::snprintf(buf, sizeof buf, "  %-10s found in %lld frames (%.1f%%)\n",
+                  r.body_names[b].c_str(), static_cast<long long>(r.body_found[b]),
+                  r.frames
+                      ? 100.0 * static_cast<double>(r.body_found[b]) / static_cast<double>(r.frames)
+                      : 0.0);
     s += buf;
   }
   if (!r.joint_names.empty()) {
@@ -204,12 +209,16 @@ std::string format_track_summary(const OfflineTrackResult& r) {
   }
   if (r.stats) {
     const std::pair<const char*, const LatencyRecorder*> stages[] = {
-        {"detect", &r.stats->detect}, {"triangulate", &r.stats->triangulate},
-        {"identify", &r.stats->identify}, {"angles", &r.stats->angles}, {"frame", &r.stats->frame}};
+        {"detect", &r.stats->detect},
+        {"triangulate", &r.stats->triangulate},
+        {"identify", &r.stats->identify},
+        {"angles", &r.stats->angles},
+        {"frame", &r.stats->frame}};
     s += "  latency per frame (us):       p50        p99        max\n";
     for (const auto& [name, rec] : stages) {
       const LatencySummary l = rec->summary();
-      std::snprintf(buf, sizeof buf, "    %-12s %14.1f %10.1f %10.1f\n", name, l.p50_us, l.p99_us, l.max_us);
+      std::snprintf(buf, sizeof buf, "    %-12s %14.1f %10.1f %10.1f\n", name, l.p50_us, l.p99_us,
+                    l.max_us);
       s += buf;
     }
   }

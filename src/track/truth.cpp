@@ -8,6 +8,7 @@
 #include <set>
 #include <sstream>
 
+#include "core/units.h"
 #include "formats/csv_outputs.h"
 #include "formats/joints_yaml.h"
 #include "formats/targets_yaml.h"
@@ -16,16 +17,14 @@
 namespace mocap {
 namespace {
 
-constexpr double kRadToDeg = 180.0 / M_PI;
-
 double rotation_angle_deg(const Quat& a, const Quat& b) {
   const double d = std::min(1.0, std::abs(a.normalized().dot(b.normalized())));
-  return 2.0 * std::acos(d) * kRadToDeg;
+  return 2.0 * std::acos(d) * kDegPerRad;
 }
 
 template <class Row>
-std::map<std::pair<std::int64_t, std::string>, const Row*> index_rows(
-    const std::vector<Row>& rows, std::string Row::*key) {
+std::map<std::pair<std::int64_t, std::string>, const Row*> index_rows(const std::vector<Row>& rows,
+                                                                      std::string Row::*key) {
   std::map<std::pair<std::int64_t, std::string>, const Row*> m;
   for (const Row& r : rows) m[{r.frame, r.*key}] = &r;
   return m;
@@ -39,7 +38,8 @@ Expected<std::vector<GtMarker>> read_gt_markers_csv(const std::string& path) {
   std::string line;
   if (!std::getline(in, line)) return make_error(path, "line 1", "empty file");
   if (line.rfind("frame,body,marker,x,y,z,u0,v0,vis0,u1,v1,vis1", 0) != 0) {
-    return make_error(path, "line 1", "expected header frame,body,marker,x,y,z,u0,v0,vis0,u1,v1,vis1");
+    return make_error(path, "line 1",
+                      "expected header frame,body,marker,x,y,z,u0,v0,vis0,u1,v1,vis1");
   }
   std::vector<GtMarker> out;
   int line_no = 1;
@@ -64,7 +64,8 @@ Expected<std::vector<GtMarker>> read_gt_markers_csv(const std::string& path) {
     }
     out.push_back(std::move(m));
   }
-  std::stable_sort(out.begin(), out.end(), [](const GtMarker& a, const GtMarker& b) { return a.frame < b.frame; });
+  std::stable_sort(out.begin(), out.end(),
+                   [](const GtMarker& a, const GtMarker& b) { return a.frame < b.frame; });
   return out;
 }
 
@@ -98,7 +99,8 @@ Expected<GroundTruth> load_ground_truth(const std::string& gt_dir) {
   return gt;
 }
 
-Expected<std::vector<AngleRow>> true_angles_from_poses(const TargetSet& targets, const JointModel& model,
+Expected<std::vector<AngleRow>> true_angles_from_poses(const TargetSet& targets,
+                                                       const JointModel& model,
                                                        const std::vector<PoseRow>& poses) {
   auto solver = kinematics::JointAngleSolver::create(model, targets.bodies.size());
   if (!solver) return solver.error();
@@ -126,7 +128,7 @@ Expected<std::vector<AngleRow>> true_angles_from_poses(const TargetSet& targets,
       r.timestamp_ns = ts;
       r.joint = model.joints[j].name;
       r.type = a.type;
-      r.angles_deg = Vec3(a.a0, a.a1, a.a2) * kRadToDeg;
+      r.angles_deg = Vec3(a.a0, a.a1, a.a2) * kDegPerRad;
       r.q_parent_child = a.q_parent_child;
       r.solved_by = "truth";
       rows.push_back(std::move(r));
@@ -159,14 +161,16 @@ AccuracyReport evaluate_against_truth(const GroundTruth& truth, const std::vecto
       }
     }
   }
-  rep.point_rmse_mm = rep.markers_recalled ? std::sqrt(sq_sum / static_cast<double>(rep.markers_recalled)) : 0.0;
+  rep.point_rmse_mm =
+      rep.markers_recalled ? std::sqrt(sq_sum / static_cast<double>(rep.markers_recalled)) : 0.0;
   rep.points = static_cast<std::int64_t>(points.size());
   for (const auto& [frame, pts] : points_by_frame) {
     const auto mit = markers_by_frame.find(frame);
     for (const PointRow* p : pts) {
       double best = 1e300;
       if (mit != markers_by_frame.end()) {
-        for (const GtMarker* m : mit->second) best = std::min(best, (p->X_world - m->X_world).norm());
+        for (const GtMarker* m : mit->second)
+          best = std::min(best, (p->X_world - m->X_world).norm());
       }
       if (best > 5.0) ++rep.points_far;
     }
@@ -250,27 +254,33 @@ AccuracyReport evaluate_against_truth(const GroundTruth& truth, const std::vecto
 std::string format_accuracy(const AccuracyReport& r) {
   std::ostringstream s;
   char buf[256];
-  std::snprintf(buf, sizeof buf,
-                "accuracy against ground truth (%lld frames)\n"
-                "  3D points: recall %.2f%% (%lld of %lld markers seen by both cameras), "
-                "RMSE %.4f mm, %lld of %lld points far (> 5 mm) from any marker\n",
-                static_cast<long long>(r.frames),
-                r.marker_views ? 100.0 * static_cast<double>(r.markers_recalled) / static_cast<double>(r.marker_views) : 0.0,
-                static_cast<long long>(r.markers_recalled), static_cast<long long>(r.marker_views),
-                r.point_rmse_mm, static_cast<long long>(r.points_far), static_cast<long long>(r.points));
+  std::snprintf(
+      buf, sizeof buf,
+      "accuracy against ground truth (%lld frames)\n"
+      "  3D points: recall %.2f%% (%lld of %lld markers seen by both cameras), "
+      "RMSE %.4f mm, %lld of %lld points far (> 5 mm) from any marker\n",
+      static_cast<long long>(r.frames),
+      r.marker_views
+          ? 100.0 * static_cast<double>(r.markers_recalled) / static_cast<double>(r.marker_views)
+          : 0.0,
+      static_cast<long long>(r.markers_recalled), static_cast<long long>(r.marker_views),
+      r.point_rmse_mm, static_cast<long long>(r.points_far), static_cast<long long>(r.points));
   s << buf;
   for (const BodyAccuracy& b : r.bodies) {
     std::snprintf(buf, sizeof buf,
                   "  body %-10s found %.2f%% of %lld frames with >= 3 markers visible, wrong %lld, "
                   "position RMS %.4f mm, rotation RMS %.4f deg\n",
                   b.body.c_str(),
-                  b.frames_visible ? 100.0 * static_cast<double>(b.frames_found) / static_cast<double>(b.frames_visible) : 0.0,
+                  b.frames_visible ? 100.0 * static_cast<double>(b.frames_found) /
+                                         static_cast<double>(b.frames_visible)
+                                   : 0.0,
                   static_cast<long long>(b.frames_visible), static_cast<long long>(b.wrong),
                   b.position_rms_mm, b.rotation_rms_deg);
     s << buf;
   }
   for (const JointAccuracy& j : r.joints) {
-    std::snprintf(buf, sizeof buf, "  joint %-10s angle error RMS %.4f deg, max %.4f deg over %lld frames\n",
+    std::snprintf(buf, sizeof buf,
+                  "  joint %-10s angle error RMS %.4f deg, max %.4f deg over %lld frames\n",
                   j.joint.c_str(), j.rms_deg, j.max_deg, static_cast<long long>(j.frames));
     s << buf;
   }

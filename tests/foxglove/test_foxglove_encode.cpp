@@ -1,12 +1,15 @@
 // Tests of the live view's scene model and encoders (pipeline/foxglove/scene.h,
 // encode.h): metres, frames and quaternion order of /tf, the SceneUpdate entities
 // (points, markers coloured by body, joint centres and hinge axes posed in the world),
-// the joint angles, and robustness to damaged counts and non-finite values.
+// the joint angles, the cameras' blob overlays (blob_overlay.h), and robustness to
+// damaged counts and non-finite values.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
 #include <nlohmann/json.hpp>
 
+#include "pipeline/foxglove/blob_overlay.h"
 #include "pipeline/foxglove/encode.h"
 
 namespace mocap::foxglove {
@@ -180,15 +183,128 @@ TEST(FoxgloveEncode, DamagedCountsAreClamped) {
   EXPECT_EQ(j["joints"].size(), static_cast<std::size_t>(client::kMaxJoints));
 }
 
+Rig two_cameras() {
+  Rig rig;
+  for (const char* n : {"left", "right"}) {
+    CameraModel c;
+    c.name = n;
+    c.width = 1032;
+    c.height = 776;
+    rig.cameras.push_back(c);
+  }
+  return rig;
+}
+
 TEST(FoxgloveEncode, ChannelsAdvertiseValidJsonSchemas) {
-  const auto channels = live_view_channels();
-  ASSERT_EQ(channels.size(), 3u);
+  const Rig rig = two_cameras();
+  const auto channels = live_view_channels(make_scene(two_bodies(), nullptr, &rig).value());
+  ASSERT_EQ(channels.size(), 5u);
   EXPECT_EQ(channels[0].topic, "/tf");
   EXPECT_EQ(channels[1].schema_name, "foxglove.SceneUpdate");
+  EXPECT_EQ(channels[3].topic, "/left/blobs");
+  EXPECT_EQ(channels[4].id, kChannelBlobsFirst + 1);
+  EXPECT_EQ(channels[4].schema_name, "foxglove.RawImage");
+  EXPECT_EQ(live_view_channels(make_scene(two_bodies(), nullptr).value()).size(), 3u);
   for (const auto& c : channels) {
     const json s = json::parse(c.schema);
     EXPECT_EQ(s["type"], "object") << c.topic;
   }
+}
+
+}  // namespace
+}  // namespace mocap::foxglove
+
+namespace mocap::foxglove {
+namespace {
+
+std::string unbase64(const std::string& s) {
+  std::string out;
+  std::uint32_t v = 0;
+  int bits = 0;
+  for (char ch : s) {
+    const std::string alphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    const std::size_t k = alphabet.find(ch);
+    if (k == std::string::npos) break;  // '=' padding
+    v = (v << 6) | static_cast<std::uint32_t>(k);
+    bits += 6;
+    if (bits >= 8) {
+      bits -= 8;
+      out.push_back(static_cast<char>((v >> bits) & 0xFFu));
+    }
+  }
+  return out;
+}
+
+TEST(FoxgloveBlobOverlay, Base64MatchesRfc4648) {
+  EXPECT_EQ(base64(""), "");
+  EXPECT_EQ(base64("f"), "Zg==");
+  EXPECT_EQ(base64("fo"), "Zm8=");
+  EXPECT_EQ(base64("foo"), "Zm9v");
+  EXPECT_EQ(base64("foob"), "Zm9vYg==");
+  EXPECT_EQ(base64("fooba"), "Zm9vYmE=");
+  EXPECT_EQ(base64("foobar"), "Zm9vYmFy");
+  std::string all;
+  for (int i = 0; i < 256; ++i) all.push_back(static_cast<char>(i));
+  EXPECT_EQ(unbase64(base64(all)), all);  // round trip over every byte value
+}
+
+// A marker blob, a point blob and an unused blob land where they are, scaled 1/4, in
+// their grey levels; the border outlines the image; damaged blobs are skipped.
+TEST(FoxgloveBlobOverlay, DrawsEachBlobWhereTheCameraSeesItInItsGreyLevel) {
+  const Rig rig = two_cameras();
+  const FoxgloveScene scene = make_scene(two_bodies(), nullptr, &rig).value();
+  auto f = std::make_unique<publish::FrameResult>();
+  f->camera_count = 2;
+  publish::CameraBlobs& cb = f->cameras[1];
+  cb.present = 1;
+  cb.count = 5;
+  cb.blobs[0] = {400.0f, 200.0f, 12.0f, static_cast<std::uint8_t>(publish::BlobUse::kMarker),
+                 1,      2,      0};
+  cb.blobs[1] = {800.0f, 600.0f, 8.0f, static_cast<std::uint8_t>(publish::BlobUse::kPoint),
+                 0,      0,      0};
+  cb.blobs[2] = {101.0f, 101.0f, 2.0f, static_cast<std::uint8_t>(publish::BlobUse::kUnused),
+                 0,      0,      0};
+  cb.blobs[3] = {NAN, 5.0f, 8.0f, 0, 0, 0, 0};
+  cb.blobs[4] = {-1e30f, 1e30f, 1e30f, 0, 0, 0, 0};
+  const json j = json::parse(encode_blob_overlay(scene, *f, 1, 1500000000));
+  EXPECT_EQ(j["frame_id"], "right");
+  EXPECT_EQ(j["encoding"], "mono8");
+  EXPECT_EQ(j["timestamp"]["sec"], 1);
+  EXPECT_EQ(j["timestamp"]["nsec"], 500000000);
+  const int w = j["width"], h = j["height"];
+  EXPECT_EQ(w, 1032 / kBlobOverlayScale);
+  EXPECT_EQ(h, 776 / kBlobOverlayScale);
+  EXPECT_EQ(j["step"], w);
+  const std::string px = unbase64(j["data"].get<std::string>());
+  ASSERT_EQ(px.size(), static_cast<std::size_t>(w * h));
+  const auto at = [&](int x, int y) {
+    return static_cast<std::uint8_t>(px[static_cast<std::size_t>(y * w + x)]);
+  };
+  EXPECT_EQ(at(100, 50), kGreyMarker);
+  EXPECT_EQ(at(99, 49), kGreyMarker);  // radius 1.5 px: the neighbours too
+  EXPECT_EQ(at(200, 150), kGreyPoint);
+  EXPECT_EQ(at(25, 25), kGreyUnused);  // a 2 px blob still covers its pixel
+  EXPECT_EQ(at(0, 0), kGreyBorder);
+  EXPECT_EQ(at(w - 1, h / 2), kGreyBorder);
+  EXPECT_EQ(at(150, 100), 0);
+  int lit = 0;
+  for (unsigned char v : px) lit += v > kGreyBorder ? 1 : 0;
+  EXPECT_LT(lit, 30);  // three small discs, nothing from the damaged blobs
+  // No such camera; a frame without blobs still gives the border.
+  EXPECT_TRUE(encode_blob_overlay(scene, *f, 2, 0).empty());
+  f->camera_count = 0;
+  const json e = json::parse(encode_blob_overlay(scene, *f, 0, 0));
+  EXPECT_EQ(unbase64(e["data"].get<std::string>()).size(), static_cast<std::size_t>(w * h));
+}
+
+// Camera names become topics: a name that is not a topic segment is a one-line error.
+TEST(FoxgloveBlobOverlay, CameraNamesMustBeTopicSegments) {
+  Rig rig = two_cameras();
+  rig.cameras[1].name = "right/../x";
+  const auto e = make_scene(two_bodies(), nullptr, &rig);
+  ASSERT_FALSE(e.ok());
+  EXPECT_NE(e.error().message.find("camera 1"), std::string::npos) << e.error().message;
+  EXPECT_EQ(e.error().message.find('\n'), std::string::npos);
 }
 
 }  // namespace

@@ -1,8 +1,10 @@
 // Reference-client check of mocap's Foxglove live view, run by the test suite (ctest
 // foxglove_reference_client): connects to ws://HOST:PORT with @foxglove/ws-protocol's
 // FoxgloveClient (the protocol's reference implementation) over `ws`, subscribes to
-// /tf, /markers and /joints, validates EVERY message against Foxglove's published JSON
-// schemas (@foxglove/schemas) or the advertised schema (/joints), and checks that
+// /tf, /markers, /joints and the cameras' /camN/blobs overlays, validates EVERY message
+// against Foxglove's published JSON schemas (@foxglove/schemas) or the advertised schema
+// (/joints), checks that each overlay's pixels decode to width x height with some blob
+// drawn, and checks that
 // FrameTransforms and SceneUpdate arrive at >= MIN_HZ. Optional hostile mode: at the
 // same time one viewer subscribes and never reads again, and others flood malformed
 // frames; the checks above must still pass. Exit status 0 = pass; failures print one
@@ -27,6 +29,8 @@ const expected = {
   "/tf": { schemaName: "foxglove.FrameTransforms", validate: ajv.compile(schemas.FrameTransforms) },
   "/markers": { schemaName: "foxglove.SceneUpdate", validate: ajv.compile(schemas.SceneUpdate) },
   "/joints": { schemaName: "mocap.JointAngles", validate: null },
+  "/cam0/blobs": { schemaName: "foxglove.RawImage", validate: ajv.compile(schemas.RawImage) },
+  "/cam1/blobs": { schemaName: "foxglove.RawImage", validate: ajv.compile(schemas.RawImage) },
 };
 const stats = {};
 const bySubscription = new Map();
@@ -98,6 +102,14 @@ client.on("message", ({ subscriptionId, data }) => {
   }
   if (sub.topic === "/tf") s.transforms += msg.transforms?.length ?? 0;
   if (sub.topic === "/markers") s.entities += msg.entities?.length ?? 0;
+  if (sub.topic.endsWith("/blobs")) {
+    // mono8: width*height bytes; blobs are the pixels brighter than the border (40).
+    const px = Buffer.from(msg.data ?? "", "base64");
+    if (msg.encoding !== "mono8" || px.length !== msg.width * msg.height || msg.step !== msg.width) {
+      if (s.bad++ < 3) fail(`${sub.topic}: ${msg.encoding} ${msg.width}x${msg.height} with ${px.length} bytes`);
+    }
+    s.entities += px.some((v) => v > 40) ? 1 : 0;
+  }
 });
 
 setTimeout(() => {
@@ -112,6 +124,9 @@ setTimeout(() => {
   }
   if (stats["/tf"] && stats["/tf"].transforms === 0) fail("/tf: no body transform in any message");
   if (stats["/markers"] && stats["/markers"].entities === 0) fail("/markers: no entity");
+  for (const t of ["/cam0/blobs", "/cam1/blobs"]) {
+    if (stats[t] && stats[t].entities === 0) fail(`${t}: no blob drawn in any image`);
+  }
   for (const f of failures) console.error(`FAIL ${f}`);
   process.exit(failures.length === 0 ? 0 : 1);
 }, seconds * 1000);

@@ -166,7 +166,7 @@ TEST(SimCamera, HotPathDoesNotAllocate) {
   auto trig = std::make_shared<SimTrigger>(small_loop());
   Pair p = open_pair(trig);
   Frame f0, f1;
-  test::AllocationScope scope;
+  mocap::test::AllocationScope scope;
   for (int i = 0; i < 100; ++i) {
     p.cam[0]->trigger();
     p.cam[0]->dequeue(f0, 10);

@@ -7,11 +7,10 @@
 #include <random>
 
 #include "core/rotation.h"
+#include "core/units.h"
 
 namespace mocap::kinematics::testing {
 namespace {
-
-constexpr double kDeg = std::numbers::pi / 180.0;
 
 struct Rng {
   std::mt19937 gen;
@@ -95,7 +94,7 @@ SyntheticChain make_chain(const SyntheticOptions& o) {
 
   const Vec3 one_axis = rng.unit();
   Mat3 plane_basis = rng.rotation();
-  const double half = o.shoulder_range_deg * kDeg / 2.0;
+  const double half = o.shoulder_range_deg * kRadPerDeg / 2.0;
   for (int i = 0; i < o.poses; ++i) {
     const Iso3 T_world_torso = make_iso(rng.rotation(), Vec3(0, 0, 2500) + rng.box(300.0));
     Mat3 R_s;
@@ -114,7 +113,7 @@ SyntheticChain make_chain(const SyntheticOptions& o) {
         break;
       }
     }
-    const double theta = rng.uniform(o.elbow_min_deg, o.elbow_max_deg) * kDeg;
+    const double theta = rng.uniform(o.elbow_min_deg, o.elbow_max_deg) * kRadPerDeg;
     const auto T = chain_poses(c.truth, c.R0_elbow, T_world_torso, R_s, theta);
     c.T_world_body_true.push_back(T);
     c.R_shoulder_true.push_back(R_s);
@@ -140,6 +139,10 @@ SyntheticChain make_chain(const SyntheticOptions& o) {
     c.input.frames.push_back(frame);
   }
   return c;
+}
+
+double angle_deg(const Vec3& a, const Vec3& b) {
+  return std::atan2(a.cross(b).norm(), a.dot(b)) * kDegPerRad;
 }
 
 }  // namespace mocap::kinematics::testing

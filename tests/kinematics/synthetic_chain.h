@@ -50,4 +50,7 @@ std::array<Iso3, 3> chain_poses(const JointModel& truth, const Mat3& R0_elbow,
                                 const Iso3& T_world_torso, const Mat3& R_shoulder,
                                 double elbow_theta_rad);
 
+// Angle between two directions, degrees.
+double angle_deg(const Vec3& a, const Vec3& b);
+
 }  // namespace mocap::kinematics::testing

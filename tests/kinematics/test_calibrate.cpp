@@ -6,22 +6,18 @@
 #include <cmath>
 #include <numbers>
 
+#include "core/units.h"
 #include "kinematics/calibrate.h"
 #include "tests/kinematics/synthetic_chain.h"
 
 namespace mocap::kinematics {
 namespace {
 
+using testing::angle_deg;
 using testing::make_chain;
 using testing::ShoulderMotion;
 using testing::SyntheticChain;
 using testing::SyntheticOptions;
-
-constexpr double kRadToDeg = 180.0 / std::numbers::pi;
-
-double angle_deg(const Vec3& a, const Vec3& b) {
-  return std::atan2(a.cross(b).norm(), a.dot(b)) * kRadToDeg;
-}
 
 const std::vector<double>* extra(const JointSpec& s, const std::string& key) {
   for (const auto& [k, v] : s.extra) {

@@ -9,6 +9,7 @@
 #include <random>
 
 #include "core/rotation.h"
+#include "core/units.h"
 #include "kinematics/calibrate.h"
 #include "kinematics/joint_angles.h"
 #include "tests/kinematics/synthetic_chain.h"
@@ -23,7 +24,6 @@ using testing::SyntheticChain;
 using testing::SyntheticOptions;
 
 constexpr double kPi = std::numbers::pi;
-constexpr double kRadToDeg = 180.0 / kPi;
 
 double wrap(double a) { return std::remainder(a, 2.0 * kPi); }
 
@@ -119,8 +119,8 @@ AngleErrors angle_errors(int calibration_poses, bool use_truth_model) {
     hinge2 += dh * dh;
   }
   AngleErrors e;
-  e.ball_rms_deg = std::sqrt(ball2 / static_cast<double>(n)) * kRadToDeg;
-  e.hinge_rms_deg = std::sqrt(hinge2 / static_cast<double>(n)) * kRadToDeg;
+  e.ball_rms_deg = std::sqrt(ball2 / static_cast<double>(n)) * kDegPerRad;
+  e.hinge_rms_deg = std::sqrt(hinge2 / static_cast<double>(n)) * kDegPerRad;
   std::printf("calibration poses %d, %s model: angle error rms ball %.4f deg, hinge %.4f deg\n",
               calibration_poses, use_truth_model ? "true" : "calibrated", e.ball_rms_deg,
               e.hinge_rms_deg);
@@ -171,8 +171,8 @@ TEST(JointAngles, HingeUnwrapsOverSeveralTurns) {
     }
     ++step;
   };
-  for (int k = 0; k <= 144; ++k) drive(k * 10.0 / kRadToDeg);
-  for (int k = 144; k >= -72; --k) drive(k * 10.0 / kRadToDeg);
+  for (int k = 0; k <= 144; ++k) drive(k * 10.0 / kDegPerRad);
+  for (int k = 144; k >= -72; --k) drive(k * 10.0 / kDegPerRad);
   // After reset the angle starts again in (-pi, pi].
   solver->reset();
   const auto v = views(chain_poses(c.truth, c.R0_elbow, T_world_torso, R_s, 4 * kPi + 0.3));

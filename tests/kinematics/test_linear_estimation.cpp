@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "core/units.h"
 #include "kinematics/joint_frame.h"
 #include "kinematics/linear_estimation.h"
 #include "tests/kinematics/synthetic_chain.h"
@@ -12,12 +13,11 @@
 namespace mocap::kinematics {
 namespace {
 
+using testing::angle_deg;
 using testing::make_chain;
 using testing::ShoulderMotion;
 using testing::SyntheticChain;
 using testing::SyntheticOptions;
-
-constexpr double kRadToDeg = 180.0 / std::numbers::pi;
 
 std::vector<RelativePose> relative(const SyntheticChain& c, int parent, int child, bool truth) {
   std::vector<RelativePose> out;
@@ -30,10 +30,6 @@ std::vector<RelativePose> relative(const SyntheticChain& c, int parent, int chil
     out.push_back(relative_pose(Tp, Tc));
   }
   return out;
-}
-
-double angle_deg(const Vec3& a, const Vec3& b) {
-  return std::atan2(a.cross(b).norm(), a.dot(b)) * kRadToDeg;
 }
 
 TEST(LinearBall, ExactOnNoiseFreePoses) {

@@ -15,6 +15,7 @@
 
 #include "hal/sim_camera.h"
 #include "pipeline/pipeline.h"
+#include "pipeline/publish/udp_publisher.h"
 
 namespace mocap::pipeline::test {
 
@@ -137,5 +138,19 @@ inline std::uint64_t counter(const PipelineStats& s, const std::string& name) {
   ADD_FAILURE() << "no counter " << name;
   return 0;
 }
+
+// A sink that sends each frame's joints through a UdpPublisher, with the publisher's
+// counters in reach of the test.
+class UdpPublisherSink final : public publish::OutputSink {
+ public:
+  explicit UdpPublisherSink(publish::UdpPublisher p) : p_(std::move(p)) {}
+  const char* name() const noexcept override { return "udp"; }
+  publish::OutputCounters counters() const noexcept override { return {}; }
+  bool publish(const publish::FrameResult& f) noexcept override { return p_.publish(f.joints); }
+  const publish::UdpPublisher& publisher() const { return p_; }
+
+ private:
+  publish::UdpPublisher p_;
+};
 
 }  // namespace mocap::pipeline::test

@@ -43,23 +43,12 @@ class StallingSink final : public publish::OutputSink {
   }
 };
 
-class UdpSink final : public publish::OutputSink {
- public:
-  explicit UdpSink(publish::UdpPublisher p) : p_(std::move(p)) {}
-  const char* name() const noexcept override { return "udp"; }
-  publish::OutputCounters counters() const noexcept override { return {}; }
-  bool publish(const publish::FrameResult& f) noexcept override { return p_.publish(f.joints); }
-
- private:
-  publish::UdpPublisher p_;
-};
-
 TEST(EndToEnd, SimCamerasToUdpClientWithGroundTruthAndGapAccounting) {
   auto rx = client::UdpReceiver::create("127.0.0.1:0");
   ASSERT_TRUE(rx.ok()) << rx.error().message;
   auto udp = publish::UdpPublisher::create({"127.0.0.1:" + std::to_string(rx->port())});
   ASSERT_TRUE(udp.ok()) << udp.error().message;
-  UdpSink udp_sink(std::move(udp).value());
+  test::UdpPublisherSink udp_sink(std::move(udp).value());
   StallingSink stall;
   RecordingSink record(400);
 

@@ -3,7 +3,7 @@
 // the datagram expects them (validity, angles, quality solved-by), the found body's pose
 // as qw>=0 quaternion + translation, its labelled markers with the residual to the
 // posed model marker (unmatched markers left out), the points with reprojection error
-// and camera count; no allocation.
+// and camera count, and each camera's blobs with what they became; no allocation.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -99,6 +99,76 @@ TEST(FrameResultBuilder, JointsPosesLabelledMarkersAndPoints) {
   EXPECT_FLOAT_EQ(r->points[1].X_world_mm[1], 5.0f);
   EXPECT_FLOAT_EQ(r->points[1].reproj_px, 0.25f);
   EXPECT_EQ(r->points[1].cameras, 2);
+}
+
+// Each camera's blobs say what they became: blob 0 of both cameras is a labelled marker
+// (point 0 of body 0), blob 1 of camera 0 with blob 2 of camera 1 a point no body
+// claimed, the others unused; a camera whose frame was missing says so.
+TEST(FrameResultBuilder, BlobsSayWhatTheyBecame) {
+  TargetSet targets;
+  MarkerTarget t;
+  t.name = "torso";
+  t.markers_body = {Vec3(0, 0, 0), Vec3(40, 0, 0), Vec3(0, 50, 0)};
+  targets.bodies.push_back(t);
+  auto out = std::make_unique<FrameOutput>();
+  out->points.set_capacity(4);
+  for (int c = 0; c < 2; ++c) {
+    out->blobs[static_cast<std::size_t>(c)] = detect::BlobList(8);
+    out->camera_present[static_cast<std::size_t>(c)] = c == 0;
+    for (int i = 0; i < 4; ++i) {
+      detect::Blob b;
+      b.x_px = 100.0 + 10.0 * i;
+      b.y_px = 50.0 + c;
+      b.area_px = static_cast<float>(M_PI * 25.0);  // a disc of 10 px diameter
+      ASSERT_TRUE(out->blobs[static_cast<std::size_t>(c)].push(b));
+    }
+  }
+  Point3 p;
+  p.X_world = Vec3(0, 0, 1000);
+  p.blob_index = {0, 0, -1, -1};
+  ASSERT_TRUE(out->points.push_back(p));
+  p.X_world = Vec3(300, 0, 1000);
+  p.blob_index = {1, 2, -1, -1};
+  ASSERT_TRUE(out->points.push_back(p));
+  p.blob_index = {7, 99, -1, -1};  // damaged indices are ignored
+  ASSERT_TRUE(out->points.push_back(p));
+  out->poses.count = 1;
+  out->poses.found = 1;
+  BodyPose& b0 = out->poses.bodies[0];
+  b0.found = true;
+  b0.T_world_body = Iso3::Identity();
+  b0.T_world_body.translate(Vec3(0, 0, 1000));
+  b0.markers = 1;
+  b0.point_index_of_marker.fill(-1);
+  b0.point_index_of_marker[0] = 0;
+
+  auto r = std::make_unique<publish::FrameResult>();
+  {
+    test::AllocationScope scope;
+    make_frame_result(1, 0, targets, *out, *r);
+    EXPECT_EQ(scope.count(), 0u);
+  }
+  using publish::BlobUse;
+  const auto use = [&](int c, int i) {
+    return static_cast<BlobUse>(
+        r->cameras[static_cast<std::size_t>(c)].blobs[static_cast<std::size_t>(i)].use);
+  };
+  ASSERT_EQ(r->camera_count, 2);
+  EXPECT_EQ(r->cameras[0].present, 1);
+  EXPECT_EQ(r->cameras[1].present, 0);
+  ASSERT_EQ(r->cameras[0].count, 4);
+  EXPECT_FLOAT_EQ(r->cameras[0].blobs[3].x_px, 130.0f);
+  EXPECT_FLOAT_EQ(r->cameras[1].blobs[0].y_px, 51.0f);
+  EXPECT_NEAR(r->cameras[0].blobs[0].diameter_px, 10.0f, 1e-4f);
+  EXPECT_EQ(use(0, 0), BlobUse::kMarker);
+  EXPECT_EQ(use(1, 0), BlobUse::kMarker);
+  EXPECT_EQ(r->cameras[0].blobs[0].body, 0);
+  EXPECT_EQ(r->cameras[0].blobs[0].marker, 0);
+  EXPECT_EQ(use(0, 1), BlobUse::kPoint);
+  EXPECT_EQ(use(1, 2), BlobUse::kPoint);
+  EXPECT_EQ(use(0, 2), BlobUse::kUnused);
+  EXPECT_EQ(use(1, 1), BlobUse::kUnused);
+  EXPECT_EQ(use(0, 3), BlobUse::kUnused);
 }
 
 }  // namespace

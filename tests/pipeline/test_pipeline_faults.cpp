@@ -77,23 +77,11 @@ class WrappedCamera final : public hal::Camera {
   std::uint64_t delivered_ = 0;
 };
 
-class UdpSink final : public publish::OutputSink {
- public:
-  explicit UdpSink(publish::UdpPublisher p) : p_(std::move(p)) {}
-  const char* name() const noexcept override { return "udp"; }
-  publish::OutputCounters counters() const noexcept override { return {}; }
-  bool publish(const publish::FrameResult& f) noexcept override { return p_.publish(f.joints); }
-  const publish::UdpPublisher& publisher() const { return p_; }
-
- private:
-  publish::UdpPublisher p_;
-};
-
 TEST(PipelineFaults, NoUdpReceiverIsCountedNotFatal) {
   auto udp =
       publish::UdpPublisher::create({"127.0.0.1:" + std::to_string(mocap::test::free_udp_port())});
   ASSERT_TRUE(udp.ok()) << udp.error().message;
-  UdpSink udp_sink(std::move(udp).value());
+  test::UdpPublisherSink udp_sink(std::move(udp).value());
   RecordingSink record(200);
   SimRigFixture rig;
   PipelineOptions opt = test::test_options();

@@ -13,8 +13,19 @@
 
 namespace mocap::test {
 
+// The test wand: three balls at 0, 110 and 300 mm along the bar.
+inline WandSpec test_wand() {
+  WandSpec w;
+  w.markers_mm = {0.0, 110.0, 300.0};
+  return w;
+}
+
+// The paper's pair about 1 m from the robot (the stalks scene's mount), for which these
+// tests' tolerances were set.
 inline std::array<CameraModel, 2> true_cameras() {
-  auto scene = sim::make_scene(sim::SimOptions{});
+  sim::SimOptions o;
+  o.scene = sim::SceneKind::kStalks;
+  auto scene = sim::make_scene(o);
   return {scene->rig.cameras[0], scene->rig.cameras[1]};
 }
 

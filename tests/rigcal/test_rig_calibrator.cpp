@@ -15,12 +15,6 @@ using test::cam0_world;
 using test::synthetic_wand_blobs;
 using test::true_cameras;
 
-WandSpec wand() {
-  WandSpec w;
-  w.markers_mm = {0.0, 110.0, 300.0};
-  return w;
-}
-
 double rot_err_deg(const Mat3& a, const Mat3& b) {
   return Eigen::AngleAxisd(a * b.transpose()).angle() * 180.0 / 3.14159265358979323846;
 }
@@ -30,7 +24,7 @@ void make_frames(const std::array<CameraModel, 2>& cams, int n, std::vector<Wand
                  std::vector<WandPose>& poses) {
   (void)cams;  // the blobs come from the true cameras in the simulator's world
   const auto world = true_cameras();
-  const auto blobs = synthetic_wand_blobs(world, wand(), n, 0.05, 0, 7);
+  const auto blobs = synthetic_wand_blobs(world, mocap::test::test_wand(), n, 0.05, 0, 7);
   const Iso3 T_cam0_world = world[0].T_cam_world();
   for (int f = 0; f < n; ++f) {
     const auto& b = blobs[static_cast<std::size_t>(f)];
@@ -58,13 +52,14 @@ TEST(Bundle, ConvergesFromPerturbedExtrinsics) {
   cams[1].t_cam_world = truth[1].t_cam_world + Vec3(12.0, -6.0, 9.0);
   std::vector<bool> use(frames.size(), true);
   auto poses_ref = poses;
-  auto st = bundle_adjust(wand(), frames, use, cams, poses, BundleOptions{});
+  auto st = bundle_adjust(mocap::test::test_wand(), frames, use, cams, poses, BundleOptions{});
   ASSERT_TRUE(st) << st.error().message;
   EXPECT_TRUE(st->converged);
   // The same optimum as when started at the truth...
   auto ref = truth;
   std::vector<bool> use_ref(frames.size(), true);
-  ASSERT_TRUE(bundle_adjust(wand(), frames, use_ref, ref, poses_ref, BundleOptions{}));
+  ASSERT_TRUE(
+      bundle_adjust(mocap::test::test_wand(), frames, use_ref, ref, poses_ref, BundleOptions{}));
   EXPECT_LT((cams[1].center_world() - ref[1].center_world()).norm(), 1e-4);
   EXPECT_LT(rot_err_deg(cams[1].R_cam_world, ref[1].R_cam_world), 1e-6);
   // ... which is close to the truth (0.05 px noise, 80 frames).
@@ -90,7 +85,7 @@ TEST(Bundle, RefinesPerturbedIntrinsics) {
   BundleOptions o;
   o.refine_intrinsics = true;
   o.outlier_px = 10.0;
-  auto st = bundle_adjust(wand(), frames, use, cams, poses, o);
+  auto st = bundle_adjust(mocap::test::test_wand(), frames, use, cams, poses, o);
   ASSERT_TRUE(st) << st.error().message;
   EXPECT_LT(std::fabs(cams[0].cx - truth[0].cx), 1.0);
   EXPECT_LT(std::fabs(cams[1].cy - truth[1].cy), 1.0);
@@ -102,10 +97,10 @@ TEST(Bundle, RefinesPerturbedIntrinsics) {
 TEST(RigCalibrator, CalibratesFromBlobsWithStrays) {
   const auto world = true_cameras();
   const auto truth = cam0_world(world);
-  const auto blobs = synthetic_wand_blobs(world, wand(), 120, 0.05, 2, 11);
+  const auto blobs = synthetic_wand_blobs(world, mocap::test::test_wand(), 120, 0.05, 2, 11);
   RigCalOptions opt;
   opt.intrinsics = IntrinsicsMode::kFixed;
-  auto r = calibrate_from_blobs(blobs, wand(), world, opt, "rec");
+  auto r = calibrate_from_blobs(blobs, mocap::test::test_wand(), world, opt, "rec");
   ASSERT_TRUE(r) << r.error().message;
   EXPECT_NEAR(r->baseline_mm, truth[1].center_world().norm(), 0.1);
   EXPECT_LT(rot_err_deg(r->cameras[1].R_cam_world, truth[1].R_cam_world), 0.01);
@@ -118,22 +113,22 @@ TEST(RigCalibrator, CalibratesFromBlobsWithStrays) {
 
 TEST(RigCalibrator, Errors) {
   const auto world = true_cameras();
-  const auto blobs = synthetic_wand_blobs(world, wand(), 40, 0.05, 0, 13);
+  const auto blobs = synthetic_wand_blobs(world, mocap::test::test_wand(), 40, 0.05, 0, 13);
   RigCalOptions opt;
   opt.min_frames = 60;
-  auto r = calibrate_from_blobs(blobs, wand(), world, opt, "rec");
+  auto r = calibrate_from_blobs(blobs, mocap::test::test_wand(), world, opt, "rec");
   ASSERT_FALSE(r);
   EXPECT_NE(r.error().message.find("rec: frames: too few frames"), std::string::npos)
       << r.error().message;
   auto blind = blobs;
   for (auto& f : blind) f[1].clear();
-  r = calibrate_from_blobs(blind, wand(), world, RigCalOptions{}, "rec");
+  r = calibrate_from_blobs(blind, mocap::test::test_wand(), world, RigCalOptions{}, "rec");
   ASSERT_FALSE(r);
   EXPECT_NE(r.error().message.find("rec: cam1: the wand was never found"), std::string::npos)
       << r.error().message;
-  WandSpec wrong = wand();
+  WandSpec wrong = mocap::test::test_wand();
   wrong.markers_mm = {0.0, 125.0, 300.0};  // close enough to label, wrong in 3D
-  const auto blobs2 = synthetic_wand_blobs(world, wand(), 60, 0.05, 0, 13);
+  const auto blobs2 = synthetic_wand_blobs(world, mocap::test::test_wand(), 60, 0.05, 0, 13);
   r = calibrate_from_blobs(blobs2, wrong, world, RigCalOptions{}, "rec");
   ASSERT_FALSE(r);
   EXPECT_NE(r.error().message.find("wrong wand spacing"), std::string::npos) << r.error().message;

@@ -16,12 +16,12 @@ namespace mocap::rt {
 namespace {
 
 #if defined(__SANITIZE_THREAD__) || defined(__SANITIZE_ADDRESS__)
-constexpr std::uint64_t kItems = 100'000;
+constexpr std::uint64_t kDropOldestItems = 100'000;
 #else
-constexpr std::uint64_t kItems = 1'000'000;
+constexpr std::uint64_t kDropOldestItems = 1'000'000;
 #endif
 
-struct Item {
+struct StressItem {
   std::uint64_t seq = 0;
   std::array<std::uint64_t, 15> words{};
 };
@@ -31,11 +31,11 @@ struct Result {
 };
 
 Result run(int depth, int consumer_spin) {
-  auto q = std::move(DropOldestQueue<Item>::create(depth).value());
+  auto q = std::move(DropOldestQueue<StressItem>::create(depth).value());
   std::atomic<bool> done{false};
   std::thread producer([&] {
-    Item it;
-    for (std::uint64_t i = 1; i <= kItems; ++i) {
+    StressItem it;
+    for (std::uint64_t i = 1; i <= kDropOldestItems; ++i) {
       it.seq = i;
       it.words.fill(i * 0x9E3779B97F4A7C15ull);
       q->push(it);
@@ -47,7 +47,7 @@ Result run(int depth, int consumer_spin) {
   volatile std::uint64_t sink = 0;
   for (;;) {
     const bool finished = done.load(std::memory_order_acquire);
-    const Item* it = q->front();
+    const StressItem* it = q->front();
     if (it == nullptr) {
       if (finished) break;
       continue;
@@ -61,8 +61,8 @@ Result run(int depth, int consumer_spin) {
     for (int k = 0; k < consumer_spin; ++k) sink = sink + 1;  // a slow encoder
   }
   producer.join();
-  EXPECT_EQ(r.received + q->dropped(), kItems);
-  EXPECT_EQ(last, kItems);  // the newest item always gets through
+  EXPECT_EQ(r.received + q->dropped(), kDropOldestItems);
+  EXPECT_EQ(last, kDropOldestItems);  // the newest item always gets through
   return r;
 }
 
@@ -70,7 +70,7 @@ TEST(DropOldestQueueStress, SlowConsumerDropsOldestIntact) {
   const Result r = run(4, 2000);
   EXPECT_EQ(r.bad, 0u);
   EXPECT_EQ(r.out_of_order, 0u);
-  EXPECT_LT(r.received, kItems);  // the consumer is far slower: drops happened
+  EXPECT_LT(r.received, kDropOldestItems);  // the consumer is far slower: drops happened
 }
 
 TEST(DropOldestQueueStress, DepthOneAndDeepQueue) {

@@ -30,8 +30,8 @@ TEST(SimRecording, LoadsBackAndGroundTruthIsConsistent) {
   auto sum = write_simulated_recording(opt, dir.path());
   ASSERT_TRUE(sum.ok()) << sum.error().message;
   EXPECT_EQ(sum->frames, 12);
-  const int markers_per_frame = make_scene(opt)->marker_count();  // 17 (limbs layout)
-  EXPECT_EQ(markers_per_frame, 17);
+  const int markers_per_frame = make_scene(opt)->marker_count();  // 16 (limbs layout)
+  EXPECT_EQ(markers_per_frame, 16);
   EXPECT_EQ(sum->marker_views, 12 * markers_per_frame * 2);
 
   auto rec = Recording::open(dir.path());

@@ -9,14 +9,13 @@
 #include <random>
 
 #include "core/rotation.h"
+#include "core/units.h"
 #include "sim/scene.h"
 #include "tests/support/alloc_counter.h"
 #include "track/chain_solver.h"
 
 namespace mocap {
 namespace {
-
-constexpr double kDeg = std::numbers::pi / 180.0;
 
 struct Fixture {
   sim::SimScene scene;
@@ -38,8 +37,8 @@ struct Fixture {
 
   sim::SceneState pose(const Vec3& shoulder_deg, double elbow_deg) const {
     sim::JointConfig jc;
-    jc.shoulder_rad = shoulder_deg * kDeg;
-    jc.elbow_rad = elbow_deg * kDeg;
+    jc.shoulder_rad = shoulder_deg * kRadPerDeg;
+    jc.elbow_rad = elbow_deg * kRadPerDeg;
     sim::SceneState st = sim::make_state(scene);
     sim::apply_config(scene, jc, st);
     return st;
@@ -48,8 +47,7 @@ struct Fixture {
   // Points of the visible markers (visible[body] = marker indices), noisy; poses of the
   // bodies in `found` as identification would report them (exact pose, all labels).
   void frame(const sim::SceneState& st, const std::array<std::vector<int>, 3>& visible,
-             const std::array<bool, 3>& found, std::vector<MeasuredPoint>& pts,
-             BodyPoses& poses) {
+             const std::array<bool, 3>& found, std::vector<MeasuredPoint>& pts, BodyPoses& poses) {
     std::normal_distribution<double> n(0.0, noise_mm);
     pts.clear();
     poses = BodyPoses{};
@@ -92,13 +90,14 @@ struct Fixture {
 
 std::vector<int> all_of(const sim::SimScene& s, int b) {
   std::vector<int> v;
-  for (std::size_t m = 0; m < s.targets.bodies[static_cast<std::size_t>(b)].markers_body.size(); ++m)
+  for (std::size_t m = 0; m < s.targets.bodies[static_cast<std::size_t>(b)].markers_body.size();
+       ++m)
     v.push_back(static_cast<int>(m));
   return v;
 }
 
 double rot_err_deg(const Mat3& A, const Mat3& B) {
-  return Eigen::AngleAxisd(A.transpose() * B).angle() / kDeg;
+  return Eigen::AngleAxisd(A.transpose() * B).angle() / kRadPerDeg;
 }
 
 constexpr std::int64_t kDt = 10'000'000;  // 100 fps
@@ -108,8 +107,8 @@ TEST(ChainSolver, HingeFromOneMarkerWithPrior) {
   std::vector<MeasuredPoint> pts;
   BodyPoses poses;
   ChainResult r;
-  const auto all = std::array<std::vector<int>, 3>{all_of(f.scene, 0), all_of(f.scene, 1),
-                                                   all_of(f.scene, 2)};
+  const auto all =
+      std::array<std::vector<int>, 3>{all_of(f.scene, 0), all_of(f.scene, 1), all_of(f.scene, 2)};
   auto st = f.pose(Vec3(-20, -30, -20), 30.0);
   f.frame(st, all, {true, true, true}, pts, poses);
   f.solver.solve(pts.data(), static_cast<int>(pts.size()), kDt, poses, r);
@@ -125,7 +124,7 @@ TEST(ChainSolver, HingeFromOneMarkerWithPrior) {
   EXPECT_EQ(r.markers[2], 1);
   EXPECT_LT(rot_err_deg(r.T_world_body[2].linear(), st.T_world_body[2].linear()), 0.1);
   EXPECT_GT(r.joints[1].sd_rad[0], 0.0);
-  EXPECT_LT(r.joints[1].sd_rad[0], 0.5 * kDeg);
+  EXPECT_LT(r.joints[1].sd_rad[0], 0.5 * kRadPerDeg);
   // The shoulder still comes from the two poses.
   EXPECT_EQ(r.joints[0].solved_by, client::SolvedBy::kPoses);
 }
@@ -158,8 +157,8 @@ TEST(ChainSolver, BallFromTwoMarkersWithPrior) {
   std::vector<MeasuredPoint> pts;
   BodyPoses poses;
   ChainResult r;
-  const auto all = std::array<std::vector<int>, 3>{all_of(f.scene, 0), all_of(f.scene, 1),
-                                                   all_of(f.scene, 2)};
+  const auto all =
+      std::array<std::vector<int>, 3>{all_of(f.scene, 0), all_of(f.scene, 1), all_of(f.scene, 2)};
   auto st = f.pose(Vec3(-10, 20, 15), 20.0);
   f.frame(st, all, {true, true, true}, pts, poses);
   f.solver.solve(pts.data(), static_cast<int>(pts.size()), kDt, poses, r);
@@ -189,7 +188,7 @@ TEST(ChainSolver, AmbiguousOrCorruptedLabelsAreNotUsed) {
   const Vec3 a_w = T_wu.linear() * spec.axis_parent.normalized();
   const Vec3 m0 = pts[pts.size() - 2].X_world;
   MeasuredPoint stray;
-  stray.X_world = c_w + Eigen::AngleAxisd(25.0 * kDeg, a_w) * (m0 - c_w);
+  stray.X_world = c_w + Eigen::AngleAxisd(25.0 * kRadPerDeg, a_w) * (m0 - c_w);
   stray.blob_index = {900, 900};
   pts.push_back(stray);
   f.solver.solve(pts.data(), static_cast<int>(pts.size()), kDt, poses, r);
@@ -201,8 +200,7 @@ TEST(ChainSolver, AmbiguousOrCorruptedLabelsAreNotUsed) {
   // A marker displaced 3 mm along its circle's tangent breaks the pairwise distances:
   // it is never used, and the joint is either solved right from the others or not at all.
   f.solver.reset();
-  f.frame(st, {all_of(f.scene, 0), all_of(f.scene, 1), {0, 1, 2}}, {true, true, false}, pts,
-          poses);
+  f.frame(st, {all_of(f.scene, 0), all_of(f.scene, 1), {0, 1, 2}}, {true, true, false}, pts, poses);
   const std::size_t bad = pts.size() - 3;
   pts[bad].X_world = c_w + Eigen::AngleAxisd(3.0 / (pts[bad].X_world - c_w).norm(), a_w) *
                                (pts[bad].X_world - c_w);
@@ -220,8 +218,7 @@ TEST(ChainSolver, AmbiguousOrCorruptedLabelsAreNotUsed) {
   ChainConfig strict;
   strict.confidence = 0.99;
   f = Fixture::make(strict);
-  f.frame(st, {all_of(f.scene, 0), all_of(f.scene, 1), {0, 1, 2}}, {true, true, false}, pts,
-          poses);
+  f.frame(st, {all_of(f.scene, 0), all_of(f.scene, 1), {0, 1, 2}}, {true, true, false}, pts, poses);
   for (std::size_t i = pts.size() - 3; i < pts.size(); ++i) pts[i].X_world += 1.5 * a_w;
   const std::uint64_t drops = f.solver.counters().chi2_drops;
   f.solver.solve(pts.data(), static_cast<int>(pts.size()), 3 * kDt, poses, r);
@@ -251,7 +248,8 @@ TEST(ChainSolver, StandardDeviationMatchesObservedError) {
     f.solver.reset();
     f.solver.solve(pts.data(), static_cast<int>(pts.size()), (trial + 1) * kDt, poses, r);
     if (r.joints[1].solved_by != client::SolvedBy::kChain) continue;
-    const double err = rot_err_deg(r.T_world_body[2].linear(), st.T_world_body[2].linear()) * kDeg;
+    const double err =
+        rot_err_deg(r.T_world_body[2].linear(), st.T_world_body[2].linear()) * kRadPerDeg;
     const double z = err / r.joints[1].sd_rad[0];
     EXPECT_LT(z, 5.0) << "trial " << trial;
     sum_z2 += z * z;
@@ -269,8 +267,8 @@ TEST(ChainSolver, SteadyStateAllocatesNothing) {
   pts.reserve(64);
   BodyPoses poses;
   ChainResult r;
-  const auto all = std::array<std::vector<int>, 3>{all_of(f.scene, 0), all_of(f.scene, 1),
-                                                   all_of(f.scene, 2)};
+  const auto all =
+      std::array<std::vector<int>, 3>{all_of(f.scene, 0), all_of(f.scene, 1), all_of(f.scene, 2)};
   auto st = f.pose(Vec3(-20, -30, -20), 30.0);
   f.frame(st, all, {true, true, true}, pts, poses);
   f.solver.solve(pts.data(), static_cast<int>(pts.size()), kDt, poses, r);

@@ -7,13 +7,12 @@
 #include <cmath>
 
 #include "core/rotation.h"
+#include "core/units.h"
 #include "tests/support/test_support.h"
 #include "track/evaluation.h"
 
 namespace mocap {
 namespace {
-
-constexpr double kDeg = M_PI / 180.0;
 
 JointModel two_joint_model() {
   JointModel m;
@@ -47,8 +46,8 @@ TEST(CalibrationErrors, KnownOffsetsAndTilt) {
   // Hinge: centre slid 2 mm along the axis (no position error) and moved 0.25 mm off it;
   // axis tilted by 0.1 deg and flipped (direction sign is free).
   est.joints[1].center_parent += Vec3(2.0, 0.25, 0.0);
-  est.joints[1].axis_parent = -(rot_z(0.1 * kDeg) * Vec3::UnitX());
-  est.joints[1].axis_child = rot_x(0.2 * kDeg) * Vec3::UnitY();
+  est.joints[1].axis_parent = -(rot_z(0.1 * kRadPerDeg) * Vec3::UnitX());
+  est.joints[1].axis_child = rot_x(0.2 * kRadPerDeg) * Vec3::UnitY();
   auto r = calibration_errors(est, truth);
   ASSERT_TRUE(r) << r.error().message;
   ASSERT_EQ(r->size(), 2u);
@@ -61,7 +60,7 @@ TEST(CalibrationErrors, KnownOffsetsAndTilt) {
   // Distance of the true centre from the estimated line (tilted by 0.1 deg, through a
   // point 2 mm along and 0.25 mm across): 0.25 cos(0.1 deg) - 2 sin(0.1 deg).
   EXPECT_NEAR((*r)[1].axis_position_parent_mm,
-              0.25 * std::cos(0.1 * kDeg) - 2.0 * std::sin(0.1 * kDeg), 1e-12);
+              0.25 * std::cos(0.1 * kRadPerDeg) - 2.0 * std::sin(0.1 * kRadPerDeg), 1e-12);
   EXPECT_NEAR((*r)[1].axis_position_child_mm, 0.0, 1e-12);
 }
 
@@ -129,7 +128,7 @@ TEST(JointPrecision, AlternatingPosesGiveKnownDeviations) {
     const double s = (f % 2 == 0) ? 1.0 : -1.0;
     const Quat q_world_torso(euler_xyz_to_rotation(Vec3(0.1 * f, -0.2, 0.05 * f)));
     const Vec3 t_world_torso(5.0 * f, 3, -1);
-    const Quat q_torso_arm(rot_z(s * 0.2 * kDeg) * rot_x(0.7));
+    const Quat q_torso_arm(rot_z(s * 0.2 * kRadPerDeg) * rot_x(0.7));
     const Vec3 t_torso_arm(20.0 + 0.5 * s, -30, 40);
     poses.push_back(pose(f, "torso", t_world_torso, q_world_torso));
     poses.push_back(pose(f, "upper_arm", t_world_torso + q_world_torso * t_torso_arm,
@@ -163,7 +162,7 @@ TEST(AngleErrors, HingeBiasAndBallGeodesic) {
     t.q_parent_child = Quat(rot_y(0.3 * f));
     truth.push_back(t);
     AngleRow m = t;
-    m.q_parent_child = Quat(rot_y(0.3 * f) * rot_x(0.04 * kDeg));  // 0.04 deg off
+    m.q_parent_child = Quat(rot_y(0.3 * f) * rot_x(0.04 * kRadPerDeg));  // 0.04 deg off
     meas.push_back(m);
     t.joint = "elbow";
     t.type = JointType::kHinge;
