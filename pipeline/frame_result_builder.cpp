@@ -52,12 +52,14 @@ void make_frame_result(std::uint64_t sequence, std::int64_t capture_ns, const Ta
   make_joints_message(sequence, capture_ns, out, result.joints);
   const int bodies = std::min(
       {out.poses.count, publish::kMaxResultBodies, static_cast<int>(targets.bodies.size())});
-  const int points = std::min(out.points.size(), publish::kMaxResultPoints);
   result.body_count = bodies;
-  result.point_count = points;
-  for (int i = 0; i < points; ++i) {
+  // The frame's 3D points as points.csv has them: the reported candidates (a candidate
+  // that lost its blob to a better one, track/point_selection.h, is not a point).
+  int points = 0;
+  for (int i = 0; i < out.points.size() && points < publish::kMaxResultPoints; ++i) {
     const Point3& p = out.points[i];
-    publish::ResultPoint& r = result.points[static_cast<std::size_t>(i)];
+    if (!p.reported) continue;
+    publish::ResultPoint& r = result.points[static_cast<std::size_t>(points++)];
     r.X_world_mm = {static_cast<float>(p.X_world.x()), static_cast<float>(p.X_world.y()),
                     static_cast<float>(p.X_world.z())};
     r.reproj_px = static_cast<float>(p.reproj_px);
@@ -65,6 +67,7 @@ void make_frame_result(std::uint64_t sequence, std::int64_t capture_ns, const Ta
     for (std::int16_t b : p.blob_index) cameras += b >= 0 ? 1 : 0;
     r.cameras = static_cast<std::uint8_t>(cameras);
   }
+  result.point_count = points;
   int markers = 0;
   for (int b = 0; b < bodies; ++b) {
     const BodyPose& pose = out.poses.bodies[static_cast<std::size_t>(b)];
@@ -119,6 +122,7 @@ void make_frame_result(std::uint64_t sequence, std::int64_t capture_ns, const Ta
     return &result.cameras[static_cast<std::size_t>(c)].blobs[static_cast<std::size_t>(bi)];
   };
   for (int p = 0; p < out.points.size(); ++p) {
+    if (!out.points[p].reported) continue;
     for (int c = 0; c < cameras; ++c) {
       if (publish::ResultBlob* r = blob_of(p, c))
         r->use = static_cast<std::uint8_t>(publish::BlobUse::kPoint);

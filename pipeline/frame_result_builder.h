@@ -1,8 +1,9 @@
 // Design: from the tracker's FrameOutput (src/track) to the one record every output sink
 // receives (publish::FrameResult): the public JointsMessage (angles with validity and
 // quality), the body poses, the labelled markers (each matched model marker with the
-// measured point and its residual to the posed model marker) and the 3D points (with
-// reprojection error and camera count). Runs on the identify thread once per frame:
+// measured point and its residual to the posed model marker), the 3D points (the
+// reported ones, as points.csv, with reprojection error and camera count) and each
+// camera's blobs with what they became. Runs on the identify thread once per frame:
 // noexcept, allocation-free; anything beyond FrameResult's fixed capacities is left out.
 // The targets give the body and marker order and the model marker positions.
 #pragma once

@@ -36,8 +36,13 @@ TEST(FrameResultBuilder, JointsPosesLabelledMarkersAndPoints) {
     p.X_world = X;
     p.reproj_px = 0.25;
     p.blob_index = {3, 4, -1, -1};
+    p.reported = true;
     ASSERT_TRUE(out->points.push_back(p));
   }
+  Point3 lost;  // a candidate that lost its blobs to a better one: not a point
+  lost.X_world = Vec3(9, 9, 9);
+  lost.blob_index = {5, 6, -1, -1};
+  ASSERT_TRUE(out->points.push_back(lost));
   out->poses.count = 2;
   out->poses.found = 1;
   BodyPose& b0 = out->poses.bodies[0];
@@ -124,6 +129,7 @@ TEST(FrameResultBuilder, BlobsSayWhatTheyBecame) {
     }
   }
   Point3 p;
+  p.reported = true;
   p.X_world = Vec3(0, 0, 1000);
   p.blob_index = {0, 0, -1, -1};
   ASSERT_TRUE(out->points.push_back(p));
@@ -131,6 +137,9 @@ TEST(FrameResultBuilder, BlobsSayWhatTheyBecame) {
   p.blob_index = {1, 2, -1, -1};
   ASSERT_TRUE(out->points.push_back(p));
   p.blob_index = {7, 99, -1, -1};  // damaged indices are ignored
+  ASSERT_TRUE(out->points.push_back(p));
+  p.reported = false;  // a candidate that lost to a better one leaves its blobs unused
+  p.blob_index = {3, 1, -1, -1};
   ASSERT_TRUE(out->points.push_back(p));
   out->poses.count = 1;
   out->poses.found = 1;
