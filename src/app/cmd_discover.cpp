@@ -35,7 +35,8 @@ int run_discover(const DiscoverArgs& a) {
   opt.point_noise_mm = a.point_noise_mm;
   opt.refine = !a.no_refine;
   if (!(opt.max_speed_mm_per_s > 0.0)) return fail("discover: --max-speed: must be > 0");
-  if (!(opt.point_noise_mm > 0.0)) return fail("discover: --point-noise: must be > 0");
+  if (!(opt.point_noise_mm >= 0.0))
+    return fail("discover: --point-noise: must be > 0 (or 0: estimated from the recording)");
 
   std::unique_ptr<ProgressBar> progress;
   discover::PointsProgress cb;
@@ -53,7 +54,14 @@ int run_discover(const DiscoverArgs& a) {
   const double seconds_points =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
-  auto result = discover::discover_model(*points, opt, a.recording);
+  std::unique_ptr<ProgressBar> tracking;
+  auto result = discover::discover_model(
+      *points, opt, a.recording,
+      discover::tracker_poses(a.recording, [&](std::int64_t done, std::int64_t total) {
+        if (!tracking) tracking = std::make_unique<ProgressBar>("discover: tracking", total);
+        tracking->update(done);
+      }));
+  if (tracking) tracking->finish();
   if (!result) return fail(result.error().message);
   for (const std::string& w : result->warnings)
     std::fprintf(stderr, "mocap: warning: %s\n", w.c_str());
@@ -92,12 +100,12 @@ int run_discover(const DiscoverArgs& a) {
   if (a.stats) {
     const discover::DiscoverStats& s = result->stats;
     std::printf(
-        "stats: frames %d, points %lld, tracks %d (%d long), clusters %d, unplaced %d; seconds: "
-        "triangulate %.2f, track %.2f, group %.2f, bodies %.2f, topology %.2f, calibrate %.2f, "
-        "total %.2f\n",
-        s.frames, s.points, s.tracks, s.long_tracks, s.clusters, s.unplaced_tracks, seconds_points,
-        s.seconds_tracking, s.seconds_grouping, s.seconds_bodies, s.seconds_topology,
-        s.seconds_calibration, seconds);
+        "stats: frames %d, points %lld, point noise %.3f mm, tracks %d (%d long), clusters %d, "
+        "unplaced %d; seconds: triangulate %.2f, track %.2f, group %.2f, bodies %.2f, tracker "
+        "%.2f, topology %.2f, calibrate %.2f, total %.2f\n",
+        s.frames, s.points, s.point_noise_mm, s.tracks, s.long_tracks, s.clusters,
+        s.unplaced_tracks, seconds_points, s.seconds_tracking, s.seconds_grouping, s.seconds_bodies,
+        s.seconds_tracker, s.seconds_topology, s.seconds_calibration, seconds);
   }
   return 0;
 }
@@ -115,7 +123,8 @@ void register_discover(CLI::App& app, int& exit_code) {
   cmd->add_option("--max-speed", args->max_speed_mm_per_s,
                   "Fastest marker speed, mm/s (tracking gates)");
   cmd->add_option("--point-noise", args->point_noise_mm,
-                  "1-sigma noise of a 3D marker point, mm (rigidity tests)");
+                  "1-sigma noise of a 3D marker point, mm (rigidity tests); default "
+                  "0: estimated from the recording's point tracks");
   cmd->add_flag("--no-refine", args->no_refine,
                 "Linear joint estimates only (no Ceres refinement)");
   cmd->add_flag("--stats", args->stats, "Print counts and the time of every step");

@@ -78,49 +78,58 @@ BodyBuild build_bodies(const std::vector<PointTrack>& tracks,
     for (int ti : b.members) placed[static_cast<std::size_t>(ti)] = 1;
     builders.push_back(std::move(b));
   }
-  // Merge duplicates of one body (largest first), then refine.
-  std::vector<int> released;
-  std::vector<char> merged(builders.size(), 0);
-  for (std::size_t i = 0; i < builders.size(); ++i)
-    for (std::size_t j = i + 1; j < builders.size(); ++j)
-      if (!merged[i] && !merged[j] && detail::merge_if_same(builders[i], builders[j], released))
-        merged[j] = 1;
-  for (int ti : released) placed[static_cast<std::size_t>(ti)] = 0;
-  {
-    std::vector<Builder> kept;
-    for (std::size_t i = 0; i < builders.size(); ++i)
-      if (!merged[i]) kept.push_back(std::move(builders[i]));
-    builders.swap(kept);
-  }
-  for (Builder& b : builders) b.refine();
-  // Every long track left over goes to the one body it fits, if exactly one.
-  std::vector<int> pool;
-  for (std::size_t ti = 0; ti < tracks.size(); ++ti)
-    if (!placed[ti] && tracks[ti].seen >= opt.min_track_frames)
-      pool.push_back(static_cast<int>(ti));
-  std::stable_sort(pool.begin(), pool.end(), [&](int x, int y) {
-    return tracks[static_cast<std::size_t>(x)].seen > tracks[static_cast<std::size_t>(y)].seen;
-  });
-  // Poses in the occlusion gaps of each body from the leftover tracks, then placement.
-  for (Builder& b : builders) b.extend_poses(pool);
+  // Twice: merge duplicates of one body (largest first), refine, then place every long
+  // track left over in the one body it fits, if exactly one. The second merge sees the
+  // bodies completed by the first placement (a body built from two time windows may
+  // share too few markers before it).
   BodyBuild out;
-  for (int ti : pool) {
-    int body = -1, marker = -1, fitting = 0;
-    Vec3 mean_body;
-    for (std::size_t bi = 0; bi < builders.size(); ++bi) {
-      Vec3 mb;
-      const int m = builders[bi].placement(ti, mb);
-      Vec3 unused;
-      if (m < 0 && !builders[bi].fits(ti, unused)) continue;
-      ++fitting;
-      body = static_cast<int>(bi);
-      marker = m;
-      mean_body = mb;
+  for (int round = 0; round < 2; ++round) {
+    std::vector<int> released;
+    std::vector<char> merged(builders.size(), 0);
+    for (std::size_t i = 0; i < builders.size(); ++i)
+      for (std::size_t j = i + 1; j < builders.size(); ++j)
+        if (!merged[i] && !merged[j] && detail::merge_if_same(builders[i], builders[j], released))
+          merged[j] = 1;
+    for (int ti : released) placed[static_cast<std::size_t>(ti)] = 0;
+    {
+      std::vector<Builder> kept;
+      for (std::size_t i = 0; i < builders.size(); ++i)
+        if (!merged[i]) kept.push_back(std::move(builders[i]));
+      builders.swap(kept);
     }
-    if (fitting == 1 && marker >= 0)
-      builders[static_cast<std::size_t>(body)].place(ti, marker, mean_body);
-    else
-      out.unplaced_tracks.push_back(ti);
+    if (round > 0 && std::none_of(merged.begin(), merged.end(), [](char m) { return m != 0; }))
+      break;  // nothing merged: the first placement stands
+    for (Builder& b : builders) b.refine();
+    std::vector<int> pool;
+    for (std::size_t ti = 0; ti < tracks.size(); ++ti)
+      if (!placed[ti] && tracks[ti].seen >= opt.min_track_frames)
+        pool.push_back(static_cast<int>(ti));
+    std::stable_sort(pool.begin(), pool.end(), [&](int x, int y) {
+      return tracks[static_cast<std::size_t>(x)].seen > tracks[static_cast<std::size_t>(y)].seen;
+    });
+    // Poses in the occlusion gaps of each body from the leftover tracks, then placement.
+    for (Builder& b : builders) b.extend_poses(pool);
+    out.unplaced_tracks.clear();
+    for (int ti : pool) {
+      int body = -1, marker = -1, fitting = 0;
+      Vec3 mean_body;
+      for (std::size_t bi = 0; bi < builders.size(); ++bi) {
+        Vec3 mb;
+        const int m = builders[bi].placement(ti, mb);
+        Vec3 unused;
+        if (m < 0 && !builders[bi].fits(ti, unused)) continue;
+        ++fitting;
+        body = static_cast<int>(bi);
+        marker = m;
+        mean_body = mb;
+      }
+      if (fitting == 1 && marker >= 0) {
+        builders[static_cast<std::size_t>(body)].place(ti, marker, mean_body);
+        placed[static_cast<std::size_t>(ti)] = 1;
+      } else {
+        out.unplaced_tracks.push_back(ti);
+      }
+    }
   }
   for (Builder& b : builders) {
     b.refine();

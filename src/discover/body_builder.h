@@ -8,15 +8,19 @@
 //  3. Placement of a track (the cluster's other tracks, then every long track left
 //     over, the fragments of occluded markers included): its positions mapped into the
 //     body frame must agree (RMS <= body_fit_tolerance_mm, <= 5 % beyond 4x) over at
-//     least min_covisible_frames posed frames, and the agreement must mean something
+//     least min_placement_frames posed frames, and the agreement must mean something
 //     (the body turned by min_pair_rotation_deg over those frames, or stayed still with
 //     the point while the scene moved). The point then joins the marker within
 //     marker_diameter/4 that it never coexists with (a re-linked fragment), or becomes
 //     a new marker when farther than one marker diameter from all; anything in between,
 //     or a track that fits two bodies, is left out and reported.
-//  4. Refinement: poses and marker positions (mean of T_world_body^-1 X over all the
-//     marker's frames) alternately, twice.
-//  5. Body frame (docs/discover.md): origin at the markers' centroid, axes parallel to
+//  4. Duplicates of one body (built from clusters of different time windows, or from
+//     fragments of a still body) are merged (body_merge.cpp), then every long track left
+//     over is placed in the one body it fits; merge and placement run a second time
+//     when the first merged anything.
+//  5. Refinement: poses and marker positions (per-axis median of T_world_body^-1 X over
+//     all the marker's frames) alternately, twice.
+//  6. Body frame (docs/discover.md): origin at the markers' centroid, axes parallel to
 //     the world axes at the reference frame.
 #pragma once
 

@@ -6,6 +6,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <vector>
 
@@ -100,7 +101,7 @@ struct Builder {
       fs.push_back(f);
       y.push_back(body.T_world_body[static_cast<std::size_t>(f)].inverse() * t.at(f));
     }
-    if (static_cast<int>(fs.size()) < opt.min_covisible_frames) return false;
+    if (static_cast<int>(fs.size()) < opt.min_placement_frames) return false;
     mean_body = Vec3::Zero();
     for (const Vec3& v : y) mean_body += v;
     mean_body /= static_cast<double>(y.size());
@@ -125,7 +126,7 @@ struct Builder {
       spread = std::max(spread, (t.at(f) - p0).norm());
     }
     return 2 * moving_frames >= static_cast<int>(fs.size()) &&
-           2 * moving_frames >= opt.min_covisible_frames && spread <= opt.static_tolerance_mm;
+           2 * moving_frames >= opt.min_placement_frames && spread <= opt.static_tolerance_mm;
   }
 
   bool overlaps_marker(int ti, int marker) const {
@@ -175,7 +176,7 @@ struct Builder {
     set.marker_diameter_mm = opt.marker_diameter_mm;
     set.bodies.push_back({"body", body.markers_body});
     IdentifyConfig cfg;
-    cfg.point_sigma_mm = std::max(cfg.point_sigma_mm, opt.point_noise_mm);
+    cfg.point_sigma_mm = std::max(cfg.point_sigma_mm, opt.sigma_mm());
     auto ident = Identifier::create(set, cfg);
     if (!ident) return;  // target not usable for identification (too many markers)
     BodyPoses poses;
@@ -200,22 +201,30 @@ struct Builder {
     }
   }
 
+  // Marker positions as the per-axis median of T_world_body^-1 X over all their frames
+  // (robust against the few biased points of a partly hidden marker), then the poses.
   void refine() {
     for (int round = 0; round < 2; ++round) {
       compute_poses();
-      std::vector<Vec3> sum(body.markers_body.size(), Vec3::Zero());
-      std::vector<int> count(body.markers_body.size(), 0);
+      std::vector<std::array<std::vector<double>, 3>> samples(body.markers_body.size());
       for (std::size_t i = 0; i < members.size(); ++i) {
         const PointTrack& t = tracks[static_cast<std::size_t>(members[i])];
+        auto& s = samples[static_cast<std::size_t>(member_marker[i])];
         for (int f = t.first; f <= t.last(); ++f) {
           if (!t.has(f) || !body.found[static_cast<std::size_t>(f)]) continue;
-          sum[static_cast<std::size_t>(member_marker[i])] +=
-              body.T_world_body[static_cast<std::size_t>(f)].inverse() * t.at(f);
-          ++count[static_cast<std::size_t>(member_marker[i])];
+          const Vec3 y = body.T_world_body[static_cast<std::size_t>(f)].inverse() * t.at(f);
+          for (int a = 0; a < 3; ++a) s[static_cast<std::size_t>(a)].push_back(y[a]);
         }
       }
-      for (std::size_t m = 0; m < sum.size(); ++m)
-        if (count[m] > 0) body.markers_body[m] = sum[m] / static_cast<double>(count[m]);
+      for (std::size_t m = 0; m < samples.size(); ++m) {
+        if (samples[m][0].empty()) continue;
+        for (int a = 0; a < 3; ++a) {
+          auto& v = samples[m][static_cast<std::size_t>(a)];
+          const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+          std::nth_element(v.begin(), mid, v.end());
+          body.markers_body[m][a] = *mid;
+        }
+      }
     }
     compute_poses();
   }

@@ -1,6 +1,7 @@
 // Design: the merge of one body built twice (body_builder_detail.h, docs/discover.md):
 // by constant relative poses where both are posed, else by the rigid alignment of >= 3
-// markers checked against the frames where both are posed.
+// markers checked against the frames where both are posed, else by markers that
+// coincide in the world while both are posed.
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
@@ -100,11 +101,53 @@ bool same_by_shape(const Builder& A, const Builder& B, Iso3& T_ab) {
   return true;
 }
 
+// Coincidence test (bodies posed together, e.g. a still torso whose tracks were cut
+// into fragments by the arm passing in front of it): over at least min_covisible_frames
+// frames where both are posed, their relative pose is constant (1 deg, 2 mm), and at
+// least 2 markers of B then lie on distinct markers of A (within 4 fit tolerances), none
+// half-way (within one marker diameter but not on a marker). Two distinct bodies cannot
+// hold markers at the same place at the same time, so this needs no motion.
+bool same_by_coincidence(const Builder& A, const Builder& B, Iso3& T_ab) {
+  std::vector<Iso3> rel;
+  for (std::size_t f = 0; f < A.frames(); ++f)
+    if (A.body.found[f] && B.body.found[f])
+      rel.push_back(A.body.T_world_body[f].inverse() * B.body.T_world_body[f]);
+  if (static_cast<int>(rel.size()) < A.opt.min_covisible_frames) return false;
+  T_ab = rel[rel.size() / 2];
+  for (const Iso3& T : rel)
+    if (Eigen::AngleAxisd(T.linear() * T_ab.linear().transpose()).angle() * kDegPerRad > 1.0 ||
+        (T.translation() - T_ab.translation()).norm() > 2.0)
+      return false;
+  const double tol = 4.0 * A.opt.body_fit_tolerance_mm();
+  std::vector<char> taken(A.body.markers_body.size(), 0);
+  int on = 0;
+  for (const Vec3& m : B.body.markers_body) {
+    const Vec3 X_a = T_ab * m;
+    std::size_t nearest = 0;
+    double d_min = 1e300;
+    for (std::size_t k = 0; k < A.body.markers_body.size(); ++k) {
+      const double d = (A.body.markers_body[k] - X_a).norm();
+      if (d < d_min) {
+        d_min = d;
+        nearest = k;
+      }
+    }
+    if (d_min <= tol && !taken[nearest]) {
+      taken[nearest] = 1;
+      ++on;
+    } else if (d_min < A.opt.marker_diameter_mm) {
+      return false;
+    }
+  }
+  return on >= 2;
+}
+
 }  // namespace
 
 bool merge_if_same(Builder& A, const Builder& B, std::vector<int>& released) {
   Iso3 T_ab = Iso3::Identity();
-  if (!same_by_poses(A, B, T_ab) && !same_by_shape(A, B, T_ab)) return false;
+  if (!same_by_poses(A, B, T_ab) && !same_by_shape(A, B, T_ab) && !same_by_coincidence(A, B, T_ab))
+    return false;
   for (std::size_t m = 0; m < B.body.markers_body.size(); ++m) {
     const Vec3 X_a = T_ab * B.body.markers_body[m];
     int nearest = -1;

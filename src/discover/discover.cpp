@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <optional>
 
 #include "discover/body_builder.h"
 #include "discover/point_tracker.h"
@@ -10,6 +11,7 @@
 #include "discover/topology.h"
 #include "identify/ambiguity.h"
 #include "identify/target_model.h"
+#include "track/calibration_input.h"
 
 namespace mocap::discover {
 namespace {
@@ -65,8 +67,9 @@ void warn_ambiguous(const TargetSet& targets, std::vector<std::string>& warnings
 
 }  // namespace
 
-Expected<DiscoverResult> discover_model(const PointSequence& seq, const DiscoverOptions& opt,
-                                        const std::string& label) {
+Expected<DiscoverResult> discover_model(const PointSequence& seq, const DiscoverOptions& options,
+                                        const std::string& label, const PoseSource& pose_source) {
+  DiscoverOptions opt = options;
   DiscoverResult r;
   DiscoverStats& st = r.stats;
   st.frames = static_cast<int>(seq.frames.size());
@@ -78,7 +81,8 @@ Expected<DiscoverResult> discover_model(const PointSequence& seq, const Discover
     return Error{label + ": no 3D marker point in any frame (no marker seen by both cameras)"};
   auto t0 = std::chrono::steady_clock::now();
 
-  const std::vector<PointTrack> tracks = track_points(seq, opt);
+  const std::vector<PointTrack> tracks = point_tracks(seq, opt);
+  st.point_noise_mm = opt.point_noise_mm;
   st.tracks = static_cast<int>(tracks.size());
   for (const PointTrack& t : tracks) st.long_tracks += t.seen >= opt.min_track_frames ? 1 : 0;
   const std::vector<char> moving = scene_motion(seq, tracks, opt);
@@ -104,6 +108,31 @@ Expected<DiscoverResult> discover_model(const PointSequence& seq, const Discover
     return Error{
         label + ": one rigid body only (" + std::to_string(built.bodies[0].markers_body.size()) +
         " markers): no joint to discover; move the robot's joints, not the robot as a whole"};
+
+  std::optional<kinematics::CalibrationInput> tracked;
+  if (pose_source) {
+    TargetSet provisional;
+    provisional.marker_diameter_mm = opt.marker_diameter_mm;
+    for (std::size_t b = 0; b < built.bodies.size(); ++b)
+      provisional.bodies.push_back({"body" + std::to_string(b), built.bodies[b].markers_body});
+    auto in = pose_source(provisional);
+    if (in && in->frames.size() == seq.frames.size()) {
+      for (std::size_t b = 0; b < built.bodies.size(); ++b)
+        for (std::size_t f = 0; f < seq.frames.size(); ++f) {
+          const kinematics::BodyObservation& obs = in->frames[f].bodies[b];
+          built.bodies[b].found[f] = obs.found ? 1 : 0;
+          if (obs.found) built.bodies[b].T_world_body[f] = obs.T_world_body;
+        }
+      tracked = std::move(in).value();
+    } else {
+      r.warnings.push_back("tracking the recording with the discovered targets failed (" +
+                           (in ? std::to_string(in->frames.size()) + " frames instead of " +
+                                     std::to_string(seq.frames.size())
+                               : in.error().message) +
+                           "); joints are estimated on the discovery poses");
+    }
+  }
+  st.seconds_tracker = seconds_since(t0);
 
   const TopologyResult topo = infer_topology(built.bodies, opt);
   st.seconds_topology = seconds_since(t0);
@@ -131,7 +160,15 @@ Expected<DiscoverResult> discover_model(const PointSequence& seq, const Discover
         joined[static_cast<std::size_t>(j.child_index)] = 1;
     r.topology.joints.push_back(j);
   }
-  r.input = make_calibration_input(ordered, tracks, seq.frames.size(), opt);
+  if (tracked) {  // the tracker's observations, bodies in output order
+    r.input.frames.resize(tracked->frames.size());
+    for (std::size_t f = 0; f < tracked->frames.size(); ++f)
+      for (int b : topo.body_order)
+        r.input.frames[f].bodies.push_back(
+            std::move(tracked->frames[f].bodies[static_cast<std::size_t>(b)]));
+  } else {
+    r.input = make_calibration_input(ordered, tracks, seq.frames.size(), opt);
+  }
 
   warn_unplaced(tracks, built.unplaced_tracks, seq.frames, r.warnings);
   warn_ambiguous(r.targets, r.warnings);
@@ -167,6 +204,17 @@ Expected<DiscoverResult> discover_model(const PointSequence& seq, const Discover
   for (const std::string& w : r.calibration.report.warnings) r.warnings.push_back(w);
   st.seconds_calibration = seconds_since(t0);
   return r;
+}
+
+PoseSource tracker_poses(const std::string& recording,
+                         std::function<void(std::int64_t, std::int64_t)> progress) {
+  return [recording, progress](const TargetSet& targets) -> Expected<kinematics::CalibrationInput> {
+    CalibrationCollectOptions collect;
+    collect.progress = progress;
+    auto collected = collect_calibration_input(recording, targets, collect);
+    if (!collected) return collected.error();
+    return std::move(collected->input);
+  };
 }
 
 }  // namespace mocap::discover

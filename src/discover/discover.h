@@ -8,6 +8,8 @@
 // warnings (unplaced tracks, symmetric targets, too little motion), never guesses.
 #pragma once
 
+#include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -25,9 +27,10 @@ struct DiscoverStats {
   int tracks = 0;       // all short-term tracks
   int long_tracks = 0;  // seen in >= min_track_frames frames
   int clusters = 0;
+  double point_noise_mm = 0.0;  // used (stated, or estimated from the tracks)
   int unplaced_tracks = 0;
   double seconds_tracking = 0.0, seconds_grouping = 0.0, seconds_bodies = 0.0,
-         seconds_topology = 0.0, seconds_calibration = 0.0;
+         seconds_tracker = 0.0, seconds_topology = 0.0, seconds_calibration = 0.0;
 };
 
 struct DiscoverResult {
@@ -40,8 +43,21 @@ struct DiscoverResult {
   DiscoverStats stats;
 };
 
-// `label` (the recording folder) prefixes error messages.
+// Poses of given targets in every frame of the recording (frame i of PointSequence).
+using PoseSource = std::function<Expected<kinematics::CalibrationInput>(const TargetSet& targets)>;
+
+// The tracker as the pose source (`mocap calibrate`'s front half, src/track
+// calibration_input.h): identification on every stereo point of a frame, partial markers
+// left out of the fits. `progress` (frames done, total) may be empty.
+PoseSource tracker_poses(const std::string& recording,
+                         std::function<void(std::int64_t, std::int64_t)> progress = {});
+
+// `label` (the recording folder) prefixes error messages. With a `poses` source, the
+// bodies found (steps 1-4) are tracked again with their discovered targets and the
+// joint topology and calibration (steps 5-6) use those poses: the tracker poses a body
+// in every frame where its target can be identified, not only where 3 of the long
+// tracks are seen. Without one (or when it fails: a warning), the discovery poses.
 Expected<DiscoverResult> discover_model(const PointSequence& points, const DiscoverOptions& options,
-                                        const std::string& label);
+                                        const std::string& label, const PoseSource& poses = {});
 
 }  // namespace mocap::discover

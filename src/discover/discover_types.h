@@ -48,14 +48,21 @@ struct DiscoverOptions {
   // Stated bounds.
   double max_speed_mm_per_s = 3000.0;    // fastest marker
   double max_accel_mm_per_s2 = 40000.0;  // fastest change of a marker's velocity (~4 g)
-  double point_noise_mm = 0.15;          // 1-sigma noise of a triangulated marker, per axis
-  double marker_diameter_mm = 12.0;      // written to targets.yaml; closest marker spacing
+  // 1-sigma noise of a triangulated marker, per axis; 0: estimated from the recording's
+  // own tracks (point_tracker.h estimate_point_noise), the default.
+  double point_noise_mm = 0.0;
+  double provisional_noise_mm = 0.15;  // gates of the first tracking pass (auto noise)
+  // Systematic error a rigid pair's distance may show across the volume (rig calibration,
+  // lens model), added to the rigidity bound.
+  double model_error_mm = 0.1;
+  double marker_diameter_mm = 12.0;  // written to targets.yaml; closest marker spacing
   // Tracking.
   int max_gap_frames = 1;    // a track coasts over this many missed frames
   double gate_sigmas = 4.0;  // noise part of every gate, in sigmas
   // Grouping.
   int min_track_frames = 10;               // shorter tracks are ignored (ghosts, glints)
-  int min_covisible_frames = 20;           // a pair test needs this many common frames
+  int min_covisible_frames = 15;           // a pair test needs this many common frames
+  int min_placement_frames = 12;           // a track joins a body over this many posed frames
   double min_pair_rotation_deg = 10.0;     // the pair's direction must turn this much
   double static_tolerance_mm = 1.0;        // a point moving less is static
   double min_scene_speed_mm_per_s = 20.0;  // a point moving faster makes the scene "moving"
@@ -66,9 +73,15 @@ struct DiscoverOptions {
   int min_frames = 30;                 // fewer frames in the recording: error
   bool refine = true;                  // Ceres refinement of the joints
 
-  // Derived tolerances (docs/discover.md).
-  double pair_distance_std_mm() const noexcept { return 3.0 * std::sqrt(2.0) * point_noise_mm; }
-  double body_fit_tolerance_mm() const noexcept { return 4.0 * point_noise_mm + 0.2; }
+  // Derived tolerances (docs/discover.md). sigma: the stated or estimated point noise
+  // (the provisional one while it is still to be estimated).
+  double sigma_mm() const noexcept {
+    return point_noise_mm > 0.0 ? point_noise_mm : provisional_noise_mm;
+  }
+  double pair_distance_std_mm() const noexcept {
+    return 3.0 * std::sqrt(2.0) * sigma_mm() + model_error_mm;
+  }
+  double body_fit_tolerance_mm() const noexcept { return 4.0 * sigma_mm() + 0.2; }
 };
 
 }  // namespace mocap::discover

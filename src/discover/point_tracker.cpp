@@ -1,6 +1,8 @@
 #include "discover/point_tracker.h"
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <limits>
 
 namespace mocap::discover {
@@ -24,7 +26,7 @@ double seconds_between(const PointSequence& seq, int a, int b) {
 
 std::vector<PointTrack> track_points(const PointSequence& seq, const DiscoverOptions& opt) {
   constexpr double kInf = std::numeric_limits<double>::infinity();
-  const double sigma = opt.point_noise_mm;
+  const double sigma = opt.sigma_mm();
   std::vector<PointTrack> done;
   std::vector<Active> active;
   for (int f = 0; f < static_cast<int>(seq.frames.size()); ++f) {
@@ -127,6 +129,81 @@ std::vector<PointTrack> track_points(const PointSequence& seq, const DiscoverOpt
   std::sort(done.begin(), done.end(),
             [](const PointTrack& a, const PointTrack& b) { return a.first < b.first; });
   return done;
+}
+
+std::vector<PointTrack> stitch_still_fragments(std::vector<PointTrack> tracks,
+                                               const DiscoverOptions& opt) {
+  // Median position of every still track (NaN x: moving or too short).
+  std::vector<Vec3> still(tracks.size(), Vec3::Constant(std::nan("")));
+  for (std::size_t k = 0; k < tracks.size(); ++k) {
+    const PointTrack& t = tracks[k];
+    if (t.seen < 3) continue;
+    std::array<std::vector<double>, 3> c;
+    for (int f = t.first; f <= t.last(); ++f)
+      if (t.has(f))
+        for (int a = 0; a < 3; ++a) c[static_cast<std::size_t>(a)].push_back(t.at(f)[a]);
+    Vec3 med;
+    for (int a = 0; a < 3; ++a) {
+      auto& v = c[static_cast<std::size_t>(a)];
+      std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+      med[a] = v[v.size() / 2];
+    }
+    bool is_still = true;
+    for (int f = t.first; f <= t.last() && is_still; ++f)
+      is_still = !t.has(f) || (t.at(f) - med).norm() <= opt.static_tolerance_mm;
+    if (is_still) still[k] = med;
+  }
+  const double gate = opt.gate_sigmas * 3.0 * opt.sigma_mm();
+  std::vector<char> absorbed(tracks.size(), 0);
+  for (std::size_t a = 0; a < tracks.size(); ++a) {  // tracks are sorted by first frame
+    if (absorbed[a] || std::isnan(still[a].x())) continue;
+    for (std::size_t b = a + 1; b < tracks.size(); ++b) {
+      if (absorbed[b] || std::isnan(still[b].x())) continue;
+      PointTrack& ta = tracks[a];
+      const PointTrack& tb = tracks[b];
+      if (tb.first <= ta.last() || (still[a] - still[b]).norm() > gate) continue;
+      while (ta.last() < tb.first - 1) ta.X_world_mm.push_back(Vec3::Constant(std::nan("")));
+      ta.X_world_mm.insert(ta.X_world_mm.end(), tb.X_world_mm.begin(), tb.X_world_mm.end());
+      ta.seen += tb.seen;
+      absorbed[b] = 1;
+    }
+  }
+  std::vector<PointTrack> out;
+  for (std::size_t k = 0; k < tracks.size(); ++k)
+    if (!absorbed[k]) out.push_back(std::move(tracks[k]));
+  return out;
+}
+
+std::vector<PointTrack> point_tracks(const PointSequence& seq, DiscoverOptions& opt) {
+  if (!(opt.point_noise_mm > 0.0)) {
+    DiscoverOptions first = opt;
+    first.point_noise_mm = opt.provisional_noise_mm;
+    opt.point_noise_mm = estimate_point_noise(track_points(seq, first), first.point_noise_mm);
+  }
+  return stitch_still_fragments(track_points(seq, opt), opt);
+}
+
+double estimate_point_noise(const std::vector<PointTrack>& tracks, double fallback) {
+  std::array<std::vector<double>, 3> d3;
+  for (const PointTrack& t : tracks)
+    for (int f = t.first; f + 3 <= t.last(); ++f) {
+      if (!t.has(f) || !t.has(f + 1) || !t.has(f + 2) || !t.has(f + 3)) continue;
+      const Vec3 d = t.at(f + 3) - 3.0 * t.at(f + 2) + 3.0 * t.at(f + 1) - t.at(f);
+      for (int k = 0; k < 3; ++k) d3[static_cast<std::size_t>(k)].push_back(d[k]);
+    }
+  if (d3[0].size() < 30) return fallback;
+  auto median = [](std::vector<double>& v) {
+    const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+    std::nth_element(v.begin(), mid, v.end());
+    return *mid;
+  };
+  double worst = 0.0;
+  for (auto& v : d3) {
+    const double m = median(v);
+    for (double& x : v) x = std::abs(x - m);
+    worst = std::max(worst, 1.4826 * median(v) / std::sqrt(20.0));
+  }
+  return std::max(0.005, worst);
 }
 
 }  // namespace mocap::discover

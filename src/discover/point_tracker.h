@@ -21,4 +21,29 @@ namespace mocap::discover {
 
 std::vector<PointTrack> track_points(const PointSequence& points, const DiscoverOptions& options);
 
+// Step 1b as discover runs it: with options.point_noise_mm = 0 (auto), a first pass with
+// provisional_noise_mm gates, the noise estimated from its tracks (estimate_point_noise)
+// and written to options.point_noise_mm, then the pass with that noise; still markers'
+// fragments stitched (stitch_still_fragments).
+std::vector<PointTrack> point_tracks(const PointSequence& points, DiscoverOptions& options);
+
+// Re-links the fragments of a still marker: a marker that stands still (a still torso)
+// but is hidden now and then (an arm passing in front) leaves one track per visible
+// stretch. Tracks that stay within static_tolerance_mm of their median position over
+// their whole life, never coexist, and whose medians agree within the noise gate
+// (gate_sigmas * 3 sigma) are one marker and are joined (NaN over the gaps): two markers
+// cannot stand at the same place in turn without the first one moving. Returns the
+// tracks, joined ones merged into the earliest, sorted by first frame.
+std::vector<PointTrack> stitch_still_fragments(std::vector<PointTrack> tracks,
+                                               const DiscoverOptions& options);
+
+// The per-axis noise of the recording's 3D points, estimated from its tracks: the third
+// difference X(f+3) - 3 X(f+2) + 3 X(f+1) - X(f) of four consecutive measurements has
+// noise variance 20 sigma^2 per axis, while smooth motion contributes only jerk * dt^3
+// (10 m/s^3 at 100 fps: 0.01 mm). sigma = 1.4826 MAD / sqrt(20) per world axis over all
+// samples, the largest of the three (stereo depth noise is 2-4x the lateral noise);
+// motion can only inflate it (looser tolerances, never tighter). Returns `fallback`
+// with fewer than 30 samples; never below 0.005 mm.
+double estimate_point_noise(const std::vector<PointTrack>& tracks, double fallback);
+
 }  // namespace mocap::discover

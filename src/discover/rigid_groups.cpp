@@ -53,7 +53,7 @@ std::vector<char> scene_motion(const PointSequence& seq, const std::vector<Point
                                      seq.frames[static_cast<std::size_t>(f - 1)].timestamp_ns);
       const double step = (t.at(f) - t.at(f - 1)).norm();
       // Noise alone moves a point by ~2 sigma per frame: require more than that too.
-      if (dt > 0.0 && step / dt > opt.min_scene_speed_mm_per_s && step > 6.0 * opt.point_noise_mm)
+      if (dt > 0.0 && step / dt > opt.min_scene_speed_mm_per_s && step > 6.0 * opt.sigma_mm())
         moving[static_cast<std::size_t>(f)] = 1;
     }
   }

@@ -22,8 +22,8 @@ int main(int argc, char** argv) {
     }
     if (const char* dump = std::getenv("DISCOVER_DUMP_TRACKS")) {  // tracks for analysis
       FILE* out = std::fopen(dump, "w");
-      const auto tracks =
-          mocap::discover::track_points(*points, mocap::discover::DiscoverOptions{});
+      mocap::discover::DiscoverOptions opt;
+      const auto tracks = mocap::discover::point_tracks(*points, opt);
       for (std::size_t k = 0; k < tracks.size(); ++k)
         for (int f = tracks[k].first; f <= tracks[k].last(); ++f)
           if (tracks[k].has(f))
@@ -32,7 +32,13 @@ int main(int argc, char** argv) {
                          tracks[k].at(f).x(), tracks[k].at(f).y(), tracks[k].at(f).z());
       std::fclose(out);
     }
-    auto r = mocap::discover::discover_model(*points, mocap::discover::DiscoverOptions{}, rec);
+    mocap::discover::DiscoverOptions opt;
+    if (const char* v = std::getenv("MINCOV")) opt.min_covisible_frames = std::atoi(v);
+    if (const char* v = std::getenv("MINPLACE")) opt.min_placement_frames = std::atoi(v);
+    auto r = mocap::discover::discover_model(*points, opt, rec,
+                                             std::getenv("NO_TRACKER_CAL") == nullptr
+                                                 ? mocap::discover::tracker_poses(rec)
+                                                 : mocap::discover::PoseSource{});
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (!r) {
       std::printf("%s: %s\n", rec.c_str(), r.error().message.c_str());
@@ -48,6 +54,8 @@ int main(int argc, char** argv) {
     std::printf("%s: %zu bodies, %zu joints, %d unplaced tracks, %.2f s: %s\n", rec.c_str(),
                 r->targets.bodies.size(), r->model.joints.size(), r->stats.unplaced_tracks, s,
                 t->describe().c_str());
+    if (std::getenv("DISCOVER_VERBOSE") != nullptr)
+      for (const std::string& line : t->body_lines) std::printf("  %s\n", line.c_str());
   }
   return bad == 0 ? 0 : 1;
 }

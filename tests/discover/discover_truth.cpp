@@ -1,5 +1,6 @@
 #include "discover_truth.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -83,6 +84,37 @@ Expected<DiscoverTruth> compare_with_truth(const std::string& rec,
         best = n;
         out.body_map[d] = b;
       }
+    std::string line = r.targets.bodies[d].name + " ->";
+    for (const auto& l : label)
+      line += l.first < 0 ? std::string(" ?")
+                          : " " + targets->bodies[static_cast<std::size_t>(l.first)].name + ":" +
+                                std::to_string(l.second);
+    {  // marker position errors after aligning the found target onto the true one
+      std::vector<std::size_t> idx;
+      for (std::size_t m = 0; m < markers.size(); ++m)
+        if (label[m].first >= 0 && label[m].first == out.body_map[d]) idx.push_back(m);
+      if (idx.size() >= 3) {
+        Eigen::Matrix3Xd S(3, static_cast<Eigen::Index>(idx.size())), D = S;
+        for (std::size_t i = 0; i < idx.size(); ++i) {
+          S.col(static_cast<Eigen::Index>(i)) = markers[idx[i]];
+          D.col(static_cast<Eigen::Index>(i)) =
+              targets->bodies[static_cast<std::size_t>(label[idx[i]].first)]
+                  .markers_body[static_cast<std::size_t>(label[idx[i]].second)];
+        }
+        Iso3 T;
+        T.matrix() = Eigen::umeyama(S, D, false);
+        line += " | errors mm:";
+        for (std::size_t i = 0; i < idx.size(); ++i) {
+          char b[32];
+          std::snprintf(
+              b, sizeof b, " %.2f",
+              (T * S.col(static_cast<Eigen::Index>(i)) - D.col(static_cast<Eigen::Index>(i)))
+                  .norm());
+          line += b;
+        }
+      }
+    }
+    out.body_lines.push_back(line);
     for (const auto& l : label) {
       if (l.first < 0) {
         ++out.unmatched_markers;

@@ -18,12 +18,13 @@ namespace mocap::test {
 
 struct DiscoverTruth {
   int true_bodies = 0;
-  int bodies_complete = 0;            // true bodies found with all but at most one marker
-  int wrong_markers = 0;              // discovered markers on another body's marker (or on none)
-  int unmatched_markers = 0;          // discovered markers matching no true marker
-  std::vector<int> body_map;          // discovered body -> true body index (-1: none)
-  bool topology_ok = false;           // same joints (parent, child, type) as the true model
-  double worst_ball_center_mm = 0.0;  // median over frames, worst joint
+  int bodies_complete = 0;              // true bodies found with all but at most one marker
+  int wrong_markers = 0;                // discovered markers on another body's marker (or on none)
+  int unmatched_markers = 0;            // discovered markers matching no true marker
+  std::vector<int> body_map;            // discovered body -> true body index (-1: none)
+  std::vector<std::string> body_lines;  // per discovered body: its markers' true labels
+  bool topology_ok = false;             // same joints (parent, child, type) as the true model
+  double worst_ball_center_mm = 0.0;    // median over frames, worst joint
   double worst_hinge_axis_deg = 0.0;
   double worst_hinge_line_mm = 0.0;  // distance of the hinge point from the true axis line
   std::string describe() const;

@@ -10,6 +10,7 @@
 //    a ball joint through the frame-independent angle of R_rel(f) R_rel(f0)^T.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 
@@ -32,7 +33,9 @@ void expect_tracks_stay_on_one_marker(const std::string& rec,
   std::map<std::int64_t, std::vector<const GtMarker*>> by_frame;
   for (const GtMarker& m : *gt) by_frame[m.frame].push_back(&m);
   discover::DiscoverOptions opt;
-  const auto tracks = discover::track_points(points, opt);
+  const auto tracks = discover::point_tracks(points, opt);  // still fragments stitched
+  EXPECT_GT(opt.point_noise_mm, 0.005);                     // estimated from the tracks
+  EXPECT_LT(opt.point_noise_mm, 0.1);
   int long_tracks = 0, switches = 0, labelled = 0;
   for (const auto& t : tracks) {
     if (t.seen < opt.min_track_frames) continue;
@@ -49,7 +52,7 @@ void expect_tracks_stay_on_one_marker(const std::string& rec,
       }
     }
   }
-  EXPECT_GE(long_tracks, 10);  // 14 markers, most seen for long stretches
+  EXPECT_GE(long_tracks, 10);  // 16 markers, most seen for long stretches
   EXPECT_GT(labelled, 1000);
   EXPECT_EQ(switches, 0);
 }
@@ -86,34 +89,58 @@ void expect_true_angles(const std::string& angles_csv, const std::string& truth_
   // targets).
   ASSERT_GE(diff.size(), 30U);
   ASSERT_GE(ball.size(), 100U);
-  auto spread = [](const std::vector<double>& v) {
+  // Deviations from the mean offset, sorted. With the discovered targets the lower arm
+  // lacks its rarely seen fifth marker: in a few frames its pose comes through the chain
+  // from 2 markers, one of them partly hidden (docs/discover.md), so the bound is on 97 %
+  // of the frames, with every frame within 3 deg.
+  auto deviations = [](const std::vector<double>& v) {
     double m = 0.0;
     for (double x : v) m += x;
     m /= static_cast<double>(v.size());
-    double worst = 0.0;
-    for (double x : v) worst = std::max(worst, std::abs(std::remainder(x - m, 360.0)));
-    return worst;
+    std::vector<double> d;
+    for (double x : v) d.push_back(std::abs(std::remainder(x - m, 360.0)));
+    std::sort(d.begin(), d.end());
+    return d;
   };
-  EXPECT_LT(std::min(spread(sum), spread(diff)), 0.5);
-  double worst_ball = 0.0;
-  for (const auto& [a, b] : ball) worst_ball = std::max(worst_ball, std::abs(a - b));
-  EXPECT_LT(worst_ball, 0.5);
+  auto p97 = [](const std::vector<double>& d) {
+    return d[static_cast<std::size_t>(0.97 * static_cast<double>(d.size() - 1))];
+  };
+  const auto d_sum = deviations(sum), d_diff = deviations(diff);
+  const auto& hinge = p97(d_sum) < p97(d_diff) ? d_sum : d_diff;  // the axis sign is free
+  EXPECT_LT(p97(hinge), 0.5);
+  EXPECT_LT(hinge.back(), 3.0);
+  std::vector<double> d_ball;
+  for (const auto& [a, b] : ball) d_ball.push_back(std::abs(a - b));
+  std::sort(d_ball.begin(), d_ball.end());
+  EXPECT_LT(p97(d_ball), 0.5);
+  EXPECT_LT(d_ball.back(), 3.0);
 }
 
 TEST(DiscoverSim, SimulatedRecordingAgainstTruth) {
   test::TempDir dir("discover_sim");
   const std::string rec = dir.file("rec"), out = dir.file("found"), trk = dir.file("track");
-  // Pinned to the stalk-mounted scene: on the default `limbs` scene discover does not yet
-  // separate the lower arm (found by the tracker in about 40 % of frames; issue 14 note).
-  auto sim = run_mocap("simulate --out " + rec + " --scene stalks --frames 150 --seed 7", 300);
+  // The default `limbs` scene: the arm hides the torso's balls and its own in turn, so
+  // most markers are seen in fragments of 10-60 frames.
+  auto sim = run_mocap("simulate --out " + rec + " --frames 150 --seed 7", 300);
   ASSERT_EQ(sim.exit_code, 0) << sim.output;
 
   auto points = discover::triangulate_recording(rec);
   ASSERT_TRUE(points) << points.error().message;
   expect_tracks_stay_on_one_marker(rec, *points);
 
-  auto r = discover::discover_model(*points, discover::DiscoverOptions{}, rec);
+  // Targets from the tracks alone must already be right; the joints are then estimated
+  // on the tracker's poses of those targets (as `mocap discover` does).
+  auto bare = discover::discover_model(*points, discover::DiscoverOptions{}, rec);
+  ASSERT_TRUE(bare) << bare.error().message;
+  auto r = discover::discover_model(*points, discover::DiscoverOptions{}, rec,
+                                    discover::tracker_poses(rec));
   ASSERT_TRUE(r) << r.error().message;
+  ASSERT_EQ(bare->targets.bodies.size(), r->targets.bodies.size());
+  for (std::size_t b = 0; b < r->targets.bodies.size(); ++b)
+    EXPECT_EQ(bare->targets.bodies[b].markers_body.size(),
+              r->targets.bodies[b].markers_body.size());
+  EXPECT_GT(r->stats.point_noise_mm, 0.005);
+  EXPECT_LT(r->stats.point_noise_mm, 0.1);
   auto truth = test::compare_with_truth(rec, *r);
   ASSERT_TRUE(truth) << truth.error().message;
   SCOPED_TRACE(truth->describe());
