@@ -49,6 +49,7 @@ Expected<std::vector<std::string>> write_recording_assets(const std::string& dir
   std::vector<std::string> written;
   if (auto r = save_rig(dir + "/rig.yaml", assets.rig); !r) return r.error();
   written.push_back("rig.yaml");
+  if (assets.targets.bodies.empty()) return written;  // recorded before any target exists
   if (!cfg.targets_path.empty()) {
     if (auto r = copy_file(cfg.targets_path, dir + "/targets.yaml"); !r) return r.error();
   } else if (auto r = save_targets(dir + "/targets.yaml", assets.targets); !r) {

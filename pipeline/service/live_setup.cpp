@@ -19,10 +19,11 @@ using config::CameraBackend;
 static_assert(config::kStageCount == pipeline::kStageCount,
               "config::kStageNames lists the stages of pipeline/stage_table.h");
 
-Expected<config::RunConfig> resolve_run_config(const std::string& path, const CliOverrides& cli) {
+Expected<config::RunConfig> resolve_run_config(const std::string& path, const CliOverrides& cli,
+                                               bool targets_required) {
   config::RunConfig cfg = config::default_run_config();
   if (!path.empty()) {
-    auto loaded = config::load_run_config(path);
+    auto loaded = config::load_run_config(path, targets_required);
     if (!loaded) return loaded.error();
     cfg = std::move(loaded).value();
   }
@@ -132,7 +133,7 @@ void say(std::FILE* log, const std::string& line, const char* command = "mocap r
 }  // namespace
 
 Expected<std::unique_ptr<LiveSetup>> LiveSetup::create(const config::RunConfig& cfg, std::FILE* log,
-                                                       const char* command) {
+                                                       const char* command, bool targets_required) {
   std::unique_ptr<LiveSetup> s(new LiveSetup());
   s->options_ = pipeline_options(cfg);
   const CameraBackend backend = cfg.cameras[0].backend;
@@ -164,7 +165,8 @@ Expected<std::unique_ptr<LiveSetup>> LiveSetup::create(const config::RunConfig& 
     auto rec = Recording::open(cfg.cameras[0].device);
     if (!rec) return rec.error();
     s->recording_ = std::make_shared<const Recording>(std::move(rec).value());
-    assets = config::load_tracking_assets(cfg, &s->recording_->rig(), nullptr, nullptr);
+    assets = config::load_tracking_assets(cfg, &s->recording_->rig(), nullptr, nullptr,
+                                          targets_required);
     for (int c = 0; c < 2; ++c) {
       auto cam = hal::ReplayCamera::open(s->recording_, c, hal::ReplayPacing::kRecordedTiming);
       if (!cam) return cam.error();
@@ -172,7 +174,7 @@ Expected<std::unique_ptr<LiveSetup>> LiveSetup::create(const config::RunConfig& 
       cams[static_cast<std::size_t>(c)] = std::move(cam).value();
     }
   } else {
-    assets = config::load_tracking_assets(cfg, nullptr, nullptr, nullptr);
+    assets = config::load_tracking_assets(cfg, nullptr, nullptr, nullptr, targets_required);
     if (!assets) return assets.error();
     for (std::size_t c = 0; c < 2; ++c) {
       const std::string& device = cfg.cameras[c].device;

@@ -42,7 +42,9 @@ struct CliOverrides {
 
 // The configuration file (or the built-in defaults when `path` is empty) with the
 // command line's overrides applied and checked.
-Expected<config::RunConfig> resolve_run_config(const std::string& path, const CliOverrides& cli);
+// targets_required = false: record/preview (config/tracking_assets.h).
+Expected<config::RunConfig> resolve_run_config(const std::string& path, const CliOverrides& cli,
+                                               bool targets_required = true);
 
 // `mocap run --check-config FILE`: prints "FILE: OK (...)" on stdout and returns 0, or
 // the one-line error on stderr and returns 1.
@@ -61,8 +63,11 @@ class LiveSetup {
   // Renders the sim loop / opens the recording / opens the devices, configures the
   // cameras and builds the tracker. Progress lines go to `log` (may be null), prefixed
   // with `command` ("mocap run", "mocap record").
+  // targets_required = false: without configured targets (replay, v4l2, libcamera) the
+  // tracker gets none and reports 3D points only (record, preview).
   static Expected<std::unique_ptr<LiveSetup>> create(const config::RunConfig& cfg, std::FILE* log,
-                                                     const char* command = "mocap run");
+                                                     const char* command = "mocap run",
+                                                     bool targets_required = true);
 
   std::array<hal::Camera*, 2> cameras() const noexcept { return {cams_[0].get(), cams_[1].get()}; }
   // The tracker, to be moved into the pipeline (once).

@@ -100,7 +100,7 @@ int preview(const PreviewArgs& a) {
   if (a.loop_given) cli.loop_frames = a.loop_frames;
   cli.no_realtime = true;  // a diagnostic: no SCHED_FIFO needed
   cli.no_iceoryx = true;
-  auto cfg = service::resolve_run_config(a.config, cli);
+  auto cfg = service::resolve_run_config(a.config, cli, false);
   if (!cfg) return fail(cfg.error().message);
   std::error_code ec;
   std::filesystem::create_directories(a.out, ec);
@@ -108,7 +108,7 @@ int preview(const PreviewArgs& a) {
     return fail(a.out + ": cannot create the folder" + (ec ? ": " + ec.message() : std::string()));
   std::signal(SIGINT, on_preview_signal);
   std::signal(SIGTERM, on_preview_signal);
-  auto live = service::LiveSetup::create(*cfg, stderr, "mocap preview");
+  auto live = service::LiveSetup::create(*cfg, stderr, "mocap preview", false);
   if (!live) return fail(live.error().message);
   const std::array<hal::CameraConfig, 2> cams = {(*live)->cameras()[0]->config(),
                                                  (*live)->cameras()[1]->config()};

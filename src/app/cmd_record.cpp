@@ -80,12 +80,12 @@ int record(const RecordArgs& a) {
   if (a.loop_given) cli.loop_frames = a.loop_frames;
   cli.no_realtime = a.no_realtime;
   cli.no_iceoryx = true;
-  auto cfg = service::resolve_run_config(a.config, cli);
+  auto cfg = service::resolve_run_config(a.config, cli, false);
   if (!cfg) return fail(cfg.error().message);
   if (auto r = record::prepare_output_dir(a.out); !r) return fail(r.error().message);
   std::signal(SIGINT, on_record_signal);
   std::signal(SIGTERM, on_record_signal);
-  auto live = service::LiveSetup::create(*cfg, stderr, "mocap record");
+  auto live = service::LiveSetup::create(*cfg, stderr, "mocap record", false);
   if (!live) return fail(live.error().message);
   for (const std::string& n : (*live)->notices())
     std::fprintf(stderr, "mocap record: note: %s\n", n.c_str());

@@ -216,7 +216,8 @@ void read_outputs(const std::string& file, const YAML::Node& node, OutputSetting
       e.where = file + ": outputs." + key + line_suffix(kv.second);
       if (kv.second.IsSequence()) {
         for (std::size_t i = 0; i < kv.second.size(); ++i)
-          e.values.push_back(formats_detail::get_string(kv.second[i], index_path("outputs." + key, i)));
+          e.values.push_back(
+              formats_detail::get_string(kv.second[i], index_path("outputs." + key, i)));
       } else if (kv.second.IsScalar()) {
         e.values.push_back(formats_detail::get_string(kv.second, "outputs." + key));
       } else {
@@ -358,7 +359,7 @@ Expected<RunConfig> parse(const std::string& path, const YAML::Node& root) {
 
 }  // namespace
 
-Expected<RunConfig> load_run_config(const std::string& path) {
+Expected<RunConfig> load_run_config(const std::string& path, bool targets_required) {
   std::string text;
   if (auto r = formats_detail::read_text_file(path, text, formats_detail::kMaxYamlFileBytes); !r)
     return r.error();
@@ -371,7 +372,7 @@ Expected<RunConfig> load_run_config(const std::string& path) {
     return parse(path, root);
   });
   if (!cfg) return cfg;
-  if (auto r = check_tracking_assets(*cfg); !r) return r.error();
+  if (auto r = check_tracking_assets(*cfg, targets_required); !r) return r.error();
   return cfg;
 }
 

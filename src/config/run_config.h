@@ -119,7 +119,8 @@ RunConfig default_run_config();
 // Parses, validates every key, resolves paths and loads the referenced rig, targets and
 // model files (and the recording of the replay backend) to check that they fit together
 // with the thresholds (FrameProcessor::create). Cameras are NOT opened.
-Expected<RunConfig> load_run_config(const std::string& path);
+// targets_required = false: record/preview (tracking_assets.h).
+Expected<RunConfig> load_run_config(const std::string& path, bool targets_required = true);
 
 // "HOST:PORT" with a non-empty host and a port in 1..65535 (the publisher resolves the
 // host). Error names `where`.

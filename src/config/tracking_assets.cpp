@@ -17,7 +17,8 @@ sim::SimOptions sim_options(const RunConfig& cfg) {
 
 Expected<TrackingAssets> load_tracking_assets(const RunConfig& cfg, const Rig* native_rig,
                                               const TargetSet* native_targets,
-                                              const JointModel* native_model) {
+                                              const JointModel* native_model,
+                                              bool targets_required) {
   const std::string file = cfg.path.empty() ? std::string("mocap run") : cfg.path;
   const char* backend = to_string(cfg.cameras[0].backend);
   TrackingAssets a;
@@ -36,7 +37,7 @@ Expected<TrackingAssets> load_tracking_assets(const RunConfig& cfg, const Rig* n
     a.targets = std::move(targets).value();
   } else if (native_targets != nullptr) {
     a.targets = *native_targets;
-  } else {
+  } else if (targets_required) {
     return make_error(file, "targets", std::string("required by the ") + backend + " backend");
   }
   if (!cfg.model_path.empty()) {
@@ -64,7 +65,7 @@ Expected<TrackingAssets> load_tracking_assets(const RunConfig& cfg, const Rig* n
   return a;
 }
 
-Expected<void> check_tracking_assets(const RunConfig& cfg) {
+Expected<void> check_tracking_assets(const RunConfig& cfg, bool targets_required) {
   const std::string file = cfg.path.empty() ? std::string("mocap run") : cfg.path;
   Expected<TrackingAssets> assets = Error{};
   switch (cfg.cameras[0].backend) {
@@ -77,12 +78,12 @@ Expected<void> check_tracking_assets(const RunConfig& cfg) {
     case CameraBackend::kReplay: {
       auto rec = Recording::open(cfg.cameras[0].device);
       if (!rec) return make_error(file, "cameras[0].device", rec.error().message);
-      assets = load_tracking_assets(cfg, &rec->rig(), nullptr, nullptr);
+      assets = load_tracking_assets(cfg, &rec->rig(), nullptr, nullptr, targets_required);
       break;
     }
     case CameraBackend::kV4l2:
     case CameraBackend::kLibcamera:
-      assets = load_tracking_assets(cfg, nullptr, nullptr, nullptr);
+      assets = load_tracking_assets(cfg, nullptr, nullptr, nullptr, targets_required);
       break;
   }
   if (!assets) return assets.error();

@@ -26,13 +26,17 @@ sim::SimOptions sim_options(const RunConfig& cfg);
 
 // `native_*` are the backend's own assets, each may be null. Errors name the
 // configuration key ("FILE: rig: required by the v4l2 backend") or the loaded file.
+// With targets_required = false (`mocap record`, `mocap preview`: cameras before any
+// target exists), a backend without targets gets an empty target set: the tracker then
+// reports 3D points only.
 Expected<TrackingAssets> load_tracking_assets(const RunConfig& cfg, const Rig* native_rig,
                                               const TargetSet* native_targets,
-                                              const JointModel* native_model);
+                                              const JointModel* native_model,
+                                              bool targets_required = true);
 
 // Load-time check: resolves the assets (building the sim scene or opening the replay
 // recording, both cheap), checks the configured camera sizes against the rig and
 // builds the tracker once with the configured thresholds.
-Expected<void> check_tracking_assets(const RunConfig& cfg);
+Expected<void> check_tracking_assets(const RunConfig& cfg, bool targets_required = true);
 
 }  // namespace mocap::config

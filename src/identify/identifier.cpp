@@ -17,7 +17,8 @@ enum : std::uint8_t { kPending, kWarm, kWarmConflict, kDone, kFound, kFoundWarm 
 
 Expected<Identifier> Identifier::create(const TargetSet& targets, const IdentifyConfig& config) {
   if (auto ok = validate_config(config); !ok) return ok.error();
-  if (targets.bodies.empty()) return make_error("targets", "bodies", "no body to identify");
+  // No body (empty targets): identify() finds nothing; the tracker reports 3D points
+  // only (`mocap record` / `mocap preview` before any target exists).
   if (static_cast<int>(targets.bodies.size()) > kMaxBodies)
     return make_error("targets", "bodies",
                       std::to_string(targets.bodies.size()) + " bodies, at most " +
