@@ -4,6 +4,9 @@
 # (A) and with `--foxglove` plus one reference viewer subscribed to every channel (B;
 # tests/foxglove/viewer_check.mjs). Prints one line per run and the trigger-to-publish
 # p50/p99 of each. Needs the npm packages of tests/foxglove (ctest -R foxglove_npm_ci).
+# With ROS2_READER=build/bench/publish/ros2_reader in the environment (and --ros2 among
+# the B flags), a ROS 2-style DDS subscriber (ROS_DOMAIN_ID) reads /joint_states and /tf
+# during every B run, so that the DDS writer has a matched reader.
 #   bench/foxglove/viewer_ab.sh MOCAP NPM_DIR [PAIRS=3] [DURATION_S=20] [EXTRA_B_FLAGS...]
 set -euo pipefail
 mocap=$1
@@ -38,7 +41,14 @@ for i in $(seq 1 "$pairs"); do
     --foxglove "127.0.0.1:$port" "${extra_b[@]}" --stats "$work/b.json" >"$work/b.log" 2>&1 &
   pid=$!
   for _ in $(seq 1 100); do (exec 3<>"/dev/tcp/127.0.0.1/$port") 2>/dev/null && break; sleep 0.1; done
+  reader_pid=
+  : >"$work/reader.log"
+  if [[ -n "${ROS2_READER:-}" ]]; then
+    "$ROS2_READER" $((duration - 3)) >"$work/reader.log" 2>&1 &
+    reader_pid=$!
+  fi
   node "$npm_dir/viewer_check.mjs" "ws://127.0.0.1:$port" $((duration - 3)) 30 >"$work/viewer.log" 2>&1 || true
+  [[ -n "$reader_pid" ]] && wait "$reader_pid" || true
   wait "$pid"
-  echo "B-$i: $(p99 "$work/b.json")  viewer: $(tr '\n' ' ' <"$work/viewer.log")"
+  echo "B-$i: $(p99 "$work/b.json")  viewer: $(tr '\n' ' ' <"$work/viewer.log") $(cat "$work/reader.log")"
 done

@@ -1,9 +1,9 @@
 // Design: what a QueuedSink costs the real-time publish thread per frame. Three cases:
 // the floor (one FrameResult copy, ~13 KB, into a preallocated buffer: what any queued
 // hand-off must pay), publish() while the worker is blocked inside encode() (queue full:
-// copy + drop-oldest, no wake syscall), and publish() to a worker that is asleep on the
-// doorbell (copy + FUTEX_WAKE: the common case at 100 fps, measured with the timer paused
-// while the worker drains and goes back to sleep).
+// copy + drop-oldest), and publish() to a worker that is asleep between its polls (the
+// common case at 100 fps; since 2026-12-02 no wake syscall either: the worker polls every
+// 1 ms; measured with the timer paused while the worker drains and goes back to sleep).
 #include <benchmark/benchmark.h>
 
 #include <atomic>

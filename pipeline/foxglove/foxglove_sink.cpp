@@ -26,6 +26,10 @@ namespace mocap::publish {
 namespace {
 
 constexpr int kFrameQueueDepth = 4;  // frames waiting for the encoder: the newest matter
+// The 3D channels (/tf, /markers, /joints) at most this often by default: a display's
+// rate. Every frame at 100 fps tripled the loopback traffic and its kernel (softirq) work,
+// which runs above the real-time stages (docs/performance.md, 2026-12-02).
+constexpr int kDefaultMaxRateHz = 50;
 
 std::int64_t clock_ns(clockid_t id) {
   timespec ts{};
@@ -36,12 +40,14 @@ std::int64_t clock_ns(clockid_t id) {
 class FoxgloveSink final : public QueuedSink {
  public:
   FoxgloveSink(foxglove::FoxgloveScene scene, std::unique_ptr<foxglove::Server> server,
-               std::string url)
+               std::string url, int max_rate_hz)
       : QueuedSink(kFrameQueueDepth),
         scene_(std::move(scene)),
         server_(std::move(server)),
         url_(std::move(url)),
-        realtime_minus_monotonic_ns_(clock_ns(CLOCK_REALTIME) - clock_ns(CLOCK_MONOTONIC)) {}
+        realtime_minus_monotonic_ns_(clock_ns(CLOCK_REALTIME) - clock_ns(CLOCK_MONOTONIC)),
+        // 10 % slack, so that frame-period jitter does not halve the rate
+        min_period_ns_(900'000'000 / max_rate_hz) {}
   ~FoxgloveSink() override {
     stop();  // the worker first (it calls the server), then the server
     server_->stop();
@@ -59,23 +65,11 @@ class FoxgloveSink final : public QueuedSink {
   void encode(const FrameResult& frame) override {
     const std::int64_t stamp_ns = frame.joints.capture_ns + realtime_minus_monotonic_ns_;
     const auto ts = static_cast<std::uint64_t>(stamp_ns > 0 ? stamp_ns : 0);
-    using foxglove::kChannelJoints, foxglove::kChannelMarkers, foxglove::kChannelTf;
-    if (server_->has_subscribers(kChannelTf)) {
-      server_->broadcast(kChannelTf, ts,
-                         std::make_shared<const std::string>(
-                             foxglove::encode_frame_transforms(scene_, frame, stamp_ns)));
-    }
-    if (server_->has_subscribers(kChannelMarkers)) {
-      server_->broadcast(kChannelMarkers, ts,
-                         std::make_shared<const std::string>(
-                             foxglove::encode_scene_update(scene_, frame, stamp_ns)));
-    }
-    if (server_->has_subscribers(kChannelJoints)) {
-      server_->broadcast(kChannelJoints, ts,
-                         std::make_shared<const std::string>(
-                             foxglove::encode_joint_angles(scene_, frame, stamp_ns)));
-    }
-    // The aiming overlays, at a low rate (capture time, so a replay runs at its own pace).
+    // Capture time, so a replay runs at its own pace; a jump back (restart) sends at once.
+    const bool scene_due = frame.joints.capture_ns - last_scene_ns_ >= min_period_ns_ ||
+                           frame.joints.capture_ns < last_scene_ns_;
+    if (scene_due) send_scene(frame, ts, stamp_ns);
+    // The aiming overlays, at a low rate.
     if (frame.joints.capture_ns - last_overlay_ns_ < foxglove::kBlobOverlayPeriodNs &&
         frame.joints.capture_ns >= last_overlay_ns_)
       return;
@@ -92,10 +86,32 @@ class FoxgloveSink final : public QueuedSink {
   }
 
  private:
+  void send_scene(const FrameResult& frame, std::uint64_t ts, std::int64_t stamp_ns) {
+    using foxglove::kChannelJoints, foxglove::kChannelMarkers, foxglove::kChannelTf;
+    last_scene_ns_ = frame.joints.capture_ns;
+    if (server_->has_subscribers(kChannelTf)) {
+      server_->broadcast(kChannelTf, ts,
+                         std::make_shared<const std::string>(
+                             foxglove::encode_frame_transforms(scene_, frame, stamp_ns)));
+    }
+    if (server_->has_subscribers(kChannelMarkers)) {
+      server_->broadcast(kChannelMarkers, ts,
+                         std::make_shared<const std::string>(
+                             foxglove::encode_scene_update(scene_, frame, stamp_ns)));
+    }
+    if (server_->has_subscribers(kChannelJoints)) {
+      server_->broadcast(kChannelJoints, ts,
+                         std::make_shared<const std::string>(
+                             foxglove::encode_joint_angles(scene_, frame, stamp_ns)));
+    }
+  }
+
   const foxglove::FoxgloveScene scene_;
   std::unique_ptr<foxglove::Server> server_;
   const std::string url_;
   const std::int64_t realtime_minus_monotonic_ns_;
+  const std::int64_t min_period_ns_;              // of the 3D channels
+  std::int64_t last_scene_ns_ = INT64_MIN / 2;    // capture time of the last 3D messages
   std::int64_t last_overlay_ns_ = INT64_MIN / 2;  // capture time of the last overlays sent
 };
 
@@ -123,6 +139,7 @@ Expected<foxglove::ServerOptions> options_of(const OutputRequest& r) {
   if (!clients) return clients.error();
   auto queue = int_option(r, "client_queue", o.client_queue_depth, 4096);
   if (!queue) return queue.error();
+  if (auto rate = int_option(r, "max_rate_hz", kDefaultMaxRateHz, 1000); !rate) return rate.error();
   o.max_clients = *clients;
   o.client_queue_depth = *queue;
   return o;
@@ -150,7 +167,9 @@ Expected<OutputCreated> create_foxglove(const OutputRequest& r, const OutputCont
       o->address.find(':') != std::string::npos ? "[" + o->address + "]" : o->address;
   const std::string url = "ws://" + host + ":" + std::to_string((*server)->port());
   (*server)->start();
-  auto sink = std::make_unique<FoxgloveSink>(std::move(*scene), std::move(*server), url);
+  auto rate = int_option(r, "max_rate_hz", kDefaultMaxRateHz, 1000);
+  if (!rate) return rate.error();
+  auto sink = std::make_unique<FoxgloveSink>(std::move(*scene), std::move(*server), url, *rate);
   if (auto s = sink->start(); !s) return s.error();
   OutputCreated out;
   out.notice = sink->notice();

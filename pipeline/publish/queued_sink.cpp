@@ -11,7 +11,10 @@
 namespace mocap::publish {
 namespace {
 
-constexpr std::int64_t kIdlePeriodNs = 100'000'000;  // idle() about every 100 ms
+constexpr std::int64_t kIdlePeriodNs = 100'000'000;    // idle() about every 100 ms
+constexpr std::int64_t kActivePollNs = 1'000'000;      // poll period while frames arrive
+constexpr std::int64_t kQuietAfterNs = 1'000'000'000;  // no frame for this long: quiet
+constexpr std::int64_t kQuietPollNs = 20'000'000;      // poll period when quiet
 
 std::int64_t monotonic_ns() noexcept {
   timespec ts{};
@@ -56,9 +59,8 @@ void QueuedSink::stop() noexcept {
 }
 
 bool QueuedSink::publish(const FrameResult& frame) noexcept {
-  (void)queue_->push(frame);  // a drop of the oldest is counted by the queue
-  bell_.ring();               // a syscall only when the worker sleeps
-  return true;
+  (void)queue_->push(frame);  // a drop of the oldest is counted by the queue; no wake-up:
+  return true;                // the worker polls (see the header)
 }
 
 OutputCounters QueuedSink::counters() const noexcept {
@@ -71,10 +73,12 @@ OutputCounters QueuedSink::counters() const noexcept {
 
 void QueuedSink::worker_loop() noexcept {
   std::int64_t last_idle_ns = monotonic_ns();
+  std::int64_t last_frame_ns = 0;
   // acquire: pairs with stop()'s release store.
   while (!stop_.load(std::memory_order_acquire)) {
     const std::uint32_t seen = bell_.snapshot();
     if (const FrameResult* frame = queue_->front()) {
+      last_frame_ns = monotonic_ns();
       try {
         encode(*frame);
         published_.add();
@@ -93,9 +97,9 @@ void QueuedSink::worker_loop() noexcept {
         failures_.add();
       }
     }
-    const std::int64_t wait_ns =
-        std::max<std::int64_t>(1'000'000, kIdlePeriodNs - (monotonic_ns() - last_idle_ns));
-    bell_.wait(seen, wait_ns);
+    const std::int64_t poll_ns = now - last_frame_ns < kQuietAfterNs ? kActivePollNs : kQuietPollNs;
+    const std::int64_t to_idle_ns = kIdlePeriodNs - (monotonic_ns() - last_idle_ns);
+    bell_.wait(seen, std::clamp<std::int64_t>(to_idle_ns, 100'000, poll_ns));  // stop() rings
   }
   queue_->release();
 }

@@ -7,14 +7,15 @@
 // stalled transport never stalls the tracker and the newest data always gets in.
 // Exceptions from encode()/idle() are caught on the worker and counted as failures.
 //
-// Wake-up: the worker sleeps on a Doorbell (futex) with a 100 ms timeout, after which it
-// calls idle() (accept connections, re-announce, ...). publish() rings the doorbell: one
-// atomic increment plus, only when the worker is actually asleep, one FUTEX_WAKE
-// syscall. At 100 fps the worker usually sleeps between frames, so that wake costs about
-// one short syscall per frame on the publish thread; the alternative, a polling worker,
-// would instead add up to its polling period of latency to every output frame and burn
-// CPU on the dual-core capture PC, so the wake is the chosen cost (measured in
-// docs/performance.md). When the worker is busy (a backlog) no syscall is made.
+// Wake-up: the publish thread makes NO syscall: publish() is the queue's copy only. The
+// worker polls the queue: every 1 ms while frames arrive, every 20 ms after 1 s without
+// one (an idle tracker costs 50 wake-ups/s per output), and calls idle() (accept
+// connections, re-announce, ...) about every 100 ms. Its Doorbell is rung by stop()
+// only. Measured (docs/performance.md, 2026-12-02): ringing a futex from the SCHED_FIFO
+// publish thread to wake this worker cost up to 2.9 ms per frame on the 2-vCPU VM with
+// the Foxglove viewer connected (sink p99 0.6-1.7 ms); polling costs the output frames
+// at most 1 ms of extra latency (0.5 ms on average) and ~1000 wake-ups/s per active
+// slow output on the worker's side, not on the real-time threads.
 //
 // Lifetime: derived classes MUST call stop() in their own destructor (the base
 // destructor also calls it, but by then the derived part is gone while the worker might

@@ -41,6 +41,11 @@ TEST(FoxgloveSink, ChecksItsRequest) {
   auto r = kind->check(opt);
   ASSERT_FALSE(r.ok());
   EXPECT_NE(r.error().message.find("max_clients"), std::string::npos) << r.error().message;
+  OutputRequest rate = request({"8765"});
+  rate.options.emplace_back("max_rate_hz", "0");
+  r = kind->check(rate);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.error().message.find("max_rate_hz"), std::string::npos) << r.error().message;
 }
 
 TEST(FoxgloveSink, PublishedFramesReachASubscribedViewer) {
@@ -72,13 +77,16 @@ TEST(FoxgloveSink, PublishedFramesReachASubscribedViewer) {
   frame.body_count = 1;
   frame.bodies[0].found = 1;
   frame.bodies[0].t_world_body_mm = {100.0, 0.0, 0.0};
-  frame.joints.capture_ns = 1'000'000;
-  for (int i = 0; i < 3; ++i) {
+  // Frames captured at 200 Hz: the 3D channels go out at most at 50 Hz (max_rate_hz), so
+  // frames 0, 4 and 8 of these 9 are sent.
+  for (int i = 0; i < 9; ++i) {
     frame.joints.sequence = static_cast<std::uint64_t>(i);
+    frame.joints.capture_ns = 1'000'000 + i * 5'000'000LL;
     EXPECT_TRUE(sink.publish(frame));
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
   int tf = 0, markers = 0, joints = 0;
+  std::uint64_t first_ts = 0;
   for (int i = 0; i < 9; ++i) {
     const auto m = viewer.read();
     ASSERT_TRUE(m.has_value()) << viewer.error;
@@ -86,6 +94,7 @@ TEST(FoxgloveSink, PublishedFramesReachASubscribedViewer) {
     std::uint64_t ts = 0;
     ASSERT_TRUE(foxglove::parse_message_data_header(
         reinterpret_cast<const std::uint8_t*>(m->data()), m->size(), sub, ts));
+    if (i == 0) first_ts = ts;
     const json j = json::parse(m->substr(foxglove::kMessageDataHeaderBytes));
     if (sub == 1) {
       ++tf;
@@ -99,7 +108,21 @@ TEST(FoxgloveSink, PublishedFramesReachASubscribedViewer) {
   EXPECT_EQ(tf, 3);
   EXPECT_EQ(markers, 3);
   EXPECT_EQ(joints, 3);
-  EXPECT_EQ(sink.counters().published, 3u);
+  // Nothing else was sent: the next message is the one of a frame captured 1 s later.
+  frame.joints.capture_ns = 1'000'000 + 1'000'000'000LL;
+  EXPECT_TRUE(sink.publish(frame));
+  const auto late = viewer.read();
+  ASSERT_TRUE(late.has_value()) << viewer.error;
+  std::uint32_t sub = 0;
+  std::uint64_t late_ts = 0;
+  ASSERT_TRUE(foxglove::parse_message_data_header(
+      reinterpret_cast<const std::uint8_t*>(late->data()), late->size(), sub, late_ts));
+  EXPECT_EQ(late_ts - first_ts, 1'000'000'000u);
+  // Every frame reached the encoder (counted after encode() returns, maybe after the
+  // viewer got its message).
+  for (int i = 0; i < 200 && sink.counters().published < 10u; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  EXPECT_EQ(sink.counters().published, 10u);
 }
 
 }  // namespace
