@@ -6,10 +6,10 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <vector>
 
+#include "core/median.h"
 #include "core/units.h"
 #include "discover/body_builder.h"
 #include "identify/identifier.h"
@@ -206,25 +206,17 @@ struct Builder {
   void refine() {
     for (int round = 0; round < 2; ++round) {
       compute_poses();
-      std::vector<std::array<std::vector<double>, 3>> samples(body.markers_body.size());
+      std::vector<std::vector<Vec3>> samples(body.markers_body.size());
       for (std::size_t i = 0; i < members.size(); ++i) {
         const PointTrack& t = tracks[static_cast<std::size_t>(members[i])];
-        auto& s = samples[static_cast<std::size_t>(member_marker[i])];
         for (int f = t.first; f <= t.last(); ++f) {
           if (!t.has(f) || !body.found[static_cast<std::size_t>(f)]) continue;
-          const Vec3 y = body.T_world_body[static_cast<std::size_t>(f)].inverse() * t.at(f);
-          for (int a = 0; a < 3; ++a) s[static_cast<std::size_t>(a)].push_back(y[a]);
+          samples[static_cast<std::size_t>(member_marker[i])].push_back(
+              body.T_world_body[static_cast<std::size_t>(f)].inverse() * t.at(f));
         }
       }
-      for (std::size_t m = 0; m < samples.size(); ++m) {
-        if (samples[m][0].empty()) continue;
-        for (int a = 0; a < 3; ++a) {
-          auto& v = samples[m][static_cast<std::size_t>(a)];
-          const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-          std::nth_element(v.begin(), mid, v.end());
-          body.markers_body[m][a] = *mid;
-        }
-      }
+      for (std::size_t m = 0; m < samples.size(); ++m)
+        if (!samples[m].empty()) body.markers_body[m] = median_position(samples[m]);
     }
     compute_poses();
   }

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 
+#include "core/median.h"
+
 namespace mocap::discover {
 namespace {
 
@@ -138,16 +140,10 @@ std::vector<PointTrack> stitch_still_fragments(std::vector<PointTrack> tracks,
   for (std::size_t k = 0; k < tracks.size(); ++k) {
     const PointTrack& t = tracks[k];
     if (t.seen < 3) continue;
-    std::array<std::vector<double>, 3> c;
+    std::vector<Vec3> pts;
     for (int f = t.first; f <= t.last(); ++f)
-      if (t.has(f))
-        for (int a = 0; a < 3; ++a) c[static_cast<std::size_t>(a)].push_back(t.at(f)[a]);
-    Vec3 med;
-    for (int a = 0; a < 3; ++a) {
-      auto& v = c[static_cast<std::size_t>(a)];
-      std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
-      med[a] = v[v.size() / 2];
-    }
+      if (t.has(f)) pts.push_back(t.at(f));
+    const Vec3 med = median_position(pts);
     bool is_still = true;
     for (int f = t.first; f <= t.last() && is_still; ++f)
       is_still = !t.has(f) || (t.at(f) - med).norm() <= opt.static_tolerance_mm;
@@ -192,16 +188,11 @@ double estimate_point_noise(const std::vector<PointTrack>& tracks, double fallba
       for (int k = 0; k < 3; ++k) d3[static_cast<std::size_t>(k)].push_back(d[k]);
     }
   if (d3[0].size() < 30) return fallback;
-  auto median = [](std::vector<double>& v) {
-    const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-    std::nth_element(v.begin(), mid, v.end());
-    return *mid;
-  };
   double worst = 0.0;
   for (auto& v : d3) {
-    const double m = median(v);
+    const double m = median_in_place(v);
     for (double& x : v) x = std::abs(x - m);
-    worst = std::max(worst, 1.4826 * median(v) / std::sqrt(20.0));
+    worst = std::max(worst, 1.4826 * median_in_place(v) / std::sqrt(20.0));
   }
   return std::max(0.005, worst);
 }

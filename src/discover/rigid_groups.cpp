@@ -3,16 +3,11 @@
 #include <algorithm>
 #include <numeric>
 
+#include "core/median.h"
 #include "core/units.h"
 
 namespace mocap::discover {
 namespace {
-
-double median_of(std::vector<double> v) {
-  const std::size_t m = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(m), v.end());
-  return v[m];
-}
 
 double max_angle_deg(const std::vector<Vec3>& dirs, const Vec3& ref, std::size_t* arg) {
   double best = -2.0;
@@ -30,10 +25,9 @@ double max_angle_deg(const std::vector<Vec3>& dirs, const Vec3& ref, std::size_t
 
 // Largest deviation of a track from its median position over `frames`.
 double spread_mm(const PointTrack& t, const std::vector<int>& frames) {
-  std::array<std::vector<double>, 3> c;
-  for (int f : frames)
-    for (int k = 0; k < 3; ++k) c[static_cast<std::size_t>(k)].push_back(t.at(f)[k]);
-  const Vec3 med(median_of(c[0]), median_of(c[1]), median_of(c[2]));
+  std::vector<Vec3> pts;
+  for (int f : frames) pts.push_back(t.at(f));
+  const Vec3 med = median_position(pts);
   double worst = 0.0;
   for (int f : frames) worst = std::max(worst, (t.at(f) - med).norm());
   return worst;
@@ -83,10 +77,10 @@ PairRelation classify_pair(const PointTrack& a, const PointTrack& b,
     dist.push_back(v.norm());
     dirs.push_back(v.normalized());
   }
-  const double med = median_of(dist);
+  const double med = median_in_place(dist);
   std::vector<double> dev(dist.size());
   for (std::size_t i = 0; i < dist.size(); ++i) dev[i] = std::abs(dist[i] - med);
-  const double robust_std = 1.4826 * median_of(dev);
+  const double robust_std = 1.4826 * median_in_place(dev);
   const double bound = opt.pair_distance_std_mm();
   const double far = static_cast<double>(std::count_if(dev.begin(), dev.end(),
                                                        [&](double x) { return x > 4.0 * bound; })) /

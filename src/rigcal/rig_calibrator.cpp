@@ -6,6 +6,7 @@
 #include <cstdarg>
 #include <cstdio>
 
+#include "core/median.h"
 #include "detect/blob_detector.h"
 #include "formats/recording.h"
 #include "rigcal/essential.h"
@@ -23,12 +24,7 @@ __attribute__((format(printf, 1, 2))) std::string fmt(const char* f, ...) {
   return buf;
 }
 
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  return *mid;
-}
+double median(std::vector<double> v) { return v.empty() ? 0.0 : median_in_place(v); }
 
 double coverage_of(const std::vector<Vec2>& pts, const CameraModel& cam, int cols, int rows) {
   std::vector<bool> cell(static_cast<std::size_t>(cols * rows), false);

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 
+#include "core/median.h"
 #include "formats/markers_csv.h"
 
 namespace mocap {
@@ -23,9 +24,7 @@ Expected<double> frame_rate_hz(const std::vector<FrameEntry>& frames,
     }
     periods_ns.push_back(static_cast<double>(dt) / static_cast<double>(df));
   }
-  const auto mid = periods_ns.begin() + static_cast<std::ptrdiff_t>(periods_ns.size() / 2);
-  std::nth_element(periods_ns.begin(), mid, periods_ns.end());
-  return 1e9 / *mid;
+  return 1e9 / median_in_place(periods_ns);
 }
 
 std::vector<std::string> trajectory_labels(const TargetSet& targets) {

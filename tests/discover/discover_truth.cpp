@@ -5,16 +5,13 @@
 #include <cmath>
 #include <map>
 
+#include "core/median.h"
 #include "formats/csv_outputs.h"
 
 namespace mocap::test {
 namespace {
 
-double median(std::vector<double> v) {
-  if (v.empty()) return 1e9;
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
-  return v[v.size() / 2];
-}
+double median(std::vector<double> v) { return v.empty() ? 1e9 : median_in_place(v); }
 
 }  // namespace
 
