@@ -8,7 +8,11 @@
 //  3. `run --config` with the calibrated rig and the discovered targets and model, its
 //     UDP datagrams received here;
 //  4. the angles match the simulator's truth (angle_truth.h).
+#include <arpa/inet.h>
 #include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
 
 #include <atomic>
 #include <chrono>
@@ -18,7 +22,7 @@
 #include <thread>
 
 #include "angle_truth.h"
-#include "client/udp_receiver.h"
+#include "client/datagram.h"
 #include "tests/support/test_support.h"
 
 namespace mocap {
@@ -81,17 +85,28 @@ TEST(Walkthrough, FromNothingToJointAnglesOnSimulatedCameras) {
   ASSERT_EQ(disc.exit_code, 0) << disc.output;
   EXPECT_NE(disc.output.find("discovered 3 bodies and 2 joints"), std::string::npos) << disc.output;
 
-  // 3. Live tracking with the results; the angles arrive over UDP.
-  auto rx = client::UdpReceiver::create("127.0.0.1:0");
-  ASSERT_TRUE(rx) << rx.error().message;
+  // 3. Live tracking with the results; the angles arrive over UDP. A socket of our own
+  // keeps every datagram (a client::UdpReceiver keeps the latest only).
+  const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
+  ASSERT_GE(fd, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ASSERT_EQ(::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a), 0);
+  socklen_t alen = sizeof a;
+  ASSERT_EQ(::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &alen), 0);
+  const int rcvbuf = 1 << 20;  // 150 datagrams of < 1 KB even if this thread is late
+  ::setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &rcvbuf, sizeof rcvbuf);
+  timeval tv{0, 50'000};
+  ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
   const std::string run_cfg =
       camera_config(dir, "run", f("scene_robot"),
                     "rig: rig.yaml\ntargets: found/targets.yaml\nmodel: found/model.yaml\n");
   test::RunResult run;
   std::atomic<bool> run_done{false};
   std::thread runner([&] {
-    run = run_mocap("run --config " + run_cfg + " --udp 127.0.0.1:" + std::to_string(rx->port()) +
-                        " --duration 2 --stats-interval 0",
+    run = run_mocap("run --config " + run_cfg + " --udp 127.0.0.1:" +
+                        std::to_string(ntohs(a.sin_port)) + " --duration 2 --stats-interval 0",
                     60);
     run_done.store(true, std::memory_order_release);  // `run` is complete
   });
@@ -102,12 +117,16 @@ TEST(Walkthrough, FromNothingToJointAnglesOnSimulatedCameras) {
   std::vector<AngleRow> found;
   std::map<std::uint64_t, bool> sequences;
   const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+  std::uint8_t buf[client::kMaxDatagramBytes + 1];
+  client::JointsMessage m;
   while (std::chrono::steady_clock::now() < until && sequences.size() < 150) {
-    if (rx->wait(std::chrono::milliseconds(50)) == 0) {
+    const ssize_t n = ::recv(fd, buf, sizeof buf, 0);
+    if (n <= 0) {
       if (run_done.load(std::memory_order_acquire)) break;  // ended, nothing pending
       continue;
     }
-    const client::JointsMessage& m = rx->latest();
+    if (client::decode_datagram(buf, static_cast<std::size_t>(n), m) != client::DecodeStatus::kOk)
+      continue;
     if (sequences[m.sequence]) continue;
     sequences[m.sequence] = true;
     const auto fr = frame_of_ns.find(m.capture_ns);
@@ -126,8 +145,9 @@ TEST(Walkthrough, FromNothingToJointAnglesOnSimulatedCameras) {
     }
   }
   runner.join();
+  ::close(fd);
   ASSERT_EQ(run.exit_code, 0) << run.output;
-  EXPECT_GE(sequences.size(), 140U);  // UDP on loopback; a receiver keeps the latest only
+  EXPECT_GE(sequences.size(), 145U);  // every frame of the recording, UDP on loopback
 
   // 4. Against the truth: every frame of the recording, both joints.
   test::expect_true_angles(found, f("scene_robot/gt/angles.csv"), 130);

@@ -83,7 +83,7 @@ TEST(FoxgloveSink, PublishedFramesReachASubscribedViewer) {
     frame.joints.sequence = static_cast<std::uint64_t>(i);
     frame.joints.capture_ns = 1'000'000 + i * 5'000'000LL;
     EXPECT_TRUE(sink.publish(frame));
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));  // the worker keeps up
   }
   int tf = 0, markers = 0, joints = 0;
   std::uint64_t first_ts = 0;
