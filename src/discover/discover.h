@@ -1,9 +1,10 @@
 // Design: `mocap discover` as a library: from the 3D points of a recording to
 // targets.yaml, joints.yaml and the calibrated model (docs/discover.md). Steps:
-// point_tracker.h (short-term tracks) -> rigid_groups.h (rigid clusters) ->
-// body_builder.h (targets, poses) -> topology.h (joint tree and types) ->
-// src/kinematics calibrate_joints (Eq. 2 / rank-5 + Ceres refinement, exactly as
-// `mocap calibrate`). Bad recordings (too few frames, nothing moving, no body or a
+// point_tracker.h (point noise, short-term tracks) -> rigid_groups.h (rigid clusters)
+// -> body_builder.h (targets, poses) -> the tracker's poses of those targets (a
+// PoseSource, src/track, as `mocap calibrate` tracks) -> topology.h (joint tree and
+// types) -> src/kinematics calibrate_joints (Eq. 2 / rank-5 + Ceres refinement, exactly
+// as `mocap calibrate`). Bad recordings (too few frames, nothing moving, no body or a
 // single body) are one-line errors prefixed by the recording's name; doubts are
 // warnings (unplaced tracks, symmetric targets, too little motion), never guesses.
 #pragma once
