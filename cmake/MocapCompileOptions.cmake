@@ -17,7 +17,7 @@ if(MOCAP_SANITIZE)
     # needs here (no AVX flags), so keep Eigen on plain malloc everywhere.
     add_compile_definitions(EIGEN_MALLOC_ALREADY_ALIGNED=1)
   endif()
-  if("thread" IN_LIST MOCAP_SANITIZE)
+  if("thread" IN_LIST MOCAP_SANITIZE AND CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
     # GCC 12 warns (-Wtsan) that TSan does not model std::atomic_thread_fence, which
     # Boost.Asio's std_fenced_block uses (the Foxglove server). Our own code uses no
     # standalone fence (grep atomic_thread_fence), so the warning is only Asio's.

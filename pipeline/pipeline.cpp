@@ -109,6 +109,7 @@ Expected<void> Pipeline::start() {
   out_ = std::make_unique<FrameOutput>(processor_.make_output());
   counters_ = std::make_unique<Counters>();
   lat_ = std::make_unique<Latencies>();  // value-initialised: every bucket 0
+  lat_->sink_work_each = std::make_unique<LatencyHistogram[]>(sinks_.size());
   processor_.reset();
   stop_.store(false, std::memory_order_relaxed);  // no thread runs yet
   triggering_done_.store(false, std::memory_order_relaxed);

@@ -228,6 +228,7 @@ class Pipeline {
   };
   struct Latencies {
     LatencyHistogram detect[2], detect_work[2], identify, identify_work, publish, sink_work;
+    std::unique_ptr<LatencyHistogram[]> sink_work_each;  // one per sink, in sinks_ order
   };
 
   static constexpr std::int64_t kIdleWaitNs = 10'000'000;  // stages re-check stop this often

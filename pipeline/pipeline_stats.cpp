@@ -58,6 +58,13 @@ PipelineStats Pipeline::stats() const {
                {"detect1_work", lat_->detect_work[1].stats()},
                {"identify_work", lat_->identify_work.stats()},
                {"sink_work", lat_->sink_work.stats()}};
+  for (std::size_t i = 0; i < sinks_.size(); ++i) {  // per sink: where publish time goes
+    std::string name = std::string("sink_work_") + sinks_[i]->name();
+    std::size_t same = 0;  // a repeated sink name gets "_2", "_3", ...: keys stay unique
+    for (std::size_t j = 0; j < i; ++j) same += std::string(sinks_[j]->name()) == sinks_[i]->name();
+    if (same > 0) name += "_" + std::to_string(same + 1);
+    s.latency.emplace_back(std::move(name), lat_->sink_work_each[i].stats());
+  }
   const hal::PairerCounters& pc = pairer_->counters();
   s.counters = {
       {"triggered", k.triggered.get()},
@@ -122,13 +129,14 @@ PipelineStats Pipeline::stats() const {
                               lib.coverage.get(2 * j + 1));
     }
   }
-  // Per output sink (the output seam): output_<name>_published/failures/dropped.
+  // Per output sink (the output seam): output_<name>_published/failures/dropped/no_listener.
   for (const publish::OutputSink* sink : sinks_) {
     const publish::OutputCounters oc = sink->counters();
     const std::string prefix = std::string("output_") + sink->name() + "_";
     s.counters.emplace_back(prefix + "published", oc.published);
     s.counters.emplace_back(prefix + "failures", oc.failures);
     s.counters.emplace_back(prefix + "dropped", oc.dropped);
+    s.counters.emplace_back(prefix + "no_listener", oc.no_listener);
   }
   return s;
 }

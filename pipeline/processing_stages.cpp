@@ -179,10 +179,13 @@ void Pipeline::publish_loop() noexcept {
     const client::JointsMessage& msg = frame.joints;
     const std::int64_t t0 = monotonic_ns();
     frame.joints.publish_ns = t0;
-    for (publish::OutputSink* s : sinks_) {
-      if (!s->publish(frame)) k.sink_failures.add();
+    std::int64_t t1 = t0;
+    for (std::size_t i = 0; i < sinks_.size(); ++i) {
+      if (!sinks_[i]->publish(frame)) k.sink_failures.add();
+      const std::int64_t t = monotonic_ns();  // vDSO clock read, no syscall
+      lat_->sink_work_each[i].record(t - t1);
+      t1 = t;
     }
-    const std::int64_t t1 = monotonic_ns();
     const std::uint64_t sequence = msg.sequence;
     if (prev_publish_ns != 0) {  // publish period, exponential average over ~16 frames
       const std::int64_t ema = publish_period_ns_.load(std::memory_order_relaxed);

@@ -56,7 +56,9 @@ Quat body_rotation(const publish::ResultBody& b) {
 Vec3 body_translation_mm(const publish::ResultBody& b) {
   return Vec3(b.t_world_body_mm[0], b.t_world_body_mm[1], b.t_world_body_mm[2]);
 }
-Vec3 to_vec3(const std::array<float, 3>& p) { return Vec3(p[0], p[1], p[2]); }
+Vec3 to_vec3(const std::array<float, 3>& p) {
+  return Vec3(static_cast<double>(p[0]), static_cast<double>(p[1]), static_cast<double>(p[2]));
+}
 
 json entity(const FoxgloveScene& scene, const json& ts, const char* id) {
   return {{"timestamp", ts},

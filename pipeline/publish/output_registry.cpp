@@ -57,6 +57,13 @@ Expected<void> check_outputs(const std::vector<OutputRequest>& requests) {
         known += (known.empty() ? "" : ", ") + std::string(kind.name);
       return make_error(r.where, "", "unknown output '" + r.name + "' (known: " + known + ")");
     }
+    const std::string known = std::string(" ") + k->options + " ";
+    for (const auto& [key, value] : r.options) {
+      if (known.find(" " + key + " ") == std::string::npos) {
+        const std::string list = k->options[0] != '\0' ? k->options : "none";
+        return make_error(r.where, key, "unknown option (known: " + list + ")");
+      }
+    }
     if (auto c = k->check(r); !c) return c.error();
   }
   return {};

@@ -40,6 +40,7 @@ struct OutputCreated {
 struct OutputKind {
   const char* name;
   const char* summary;  // one line for help and docs
+  const char* options;  // the option keys it accepts, space-separated ("" if none)
   Expected<void> (*check)(const OutputRequest& request);
   Expected<OutputCreated> (*create)(const OutputRequest& request, const OutputContext& context);
 };
@@ -51,7 +52,8 @@ const OutputKind* find_output_kind(const std::string& name) noexcept;
 // "true"/"false" (also yes/no, on/off, 1/0) of a one-value request; error names `where`.
 Expected<bool> request_flag(const OutputRequest& request);
 
-// check() of every request (unknown names included: "...: unknown output 'x' (known: ...)").
+// check() of every request (unknown names included: "...: unknown output 'x' (known: ...)";
+// unknown option keys: "...: outputs.foxglove.max_client: unknown option (known: ...)").
 Expected<void> check_outputs(const std::vector<OutputRequest>& requests);
 
 // Builds every request in order; notices (one line each) are appended to `notices`.

@@ -91,23 +91,32 @@ UdpPublisher::~UdpPublisher() {
   if (fd_ >= 0) ::close(fd_);
 }
 
-bool UdpPublisher::publish(const client::JointsMessage& msg) noexcept {
+UdpPublisher::Status UdpPublisher::publish(const client::JointsMessage& msg) noexcept {
   ++counters_.messages;
   const std::size_t size = client::encode_datagram(msg, buf_.data(), buf_.size());
   if (size == 0) {
     ++counters_.encode_failures;
-    return false;
+    return Status::kFailed;
   }
-  bool all = true;
-  for (const sockaddr_in& dest : destinations_) {
+  Status status = Status::kSent;
+  const auto send = [&](const sockaddr_in& dest) noexcept -> int {
     const ssize_t n = ::sendto(fd_, buf_.data(), size, MSG_DONTWAIT | MSG_NOSIGNAL,
                                reinterpret_cast<const sockaddr*>(&dest), sizeof(dest));
-    if (n == static_cast<ssize_t>(size)) {
+    return n == static_cast<ssize_t>(size) ? 0 : (n < 0 ? errno : EMSGSIZE);
+  };
+  for (const sockaddr_in& dest : destinations_) {
+    int err = send(dest);
+    const bool refused = err == ECONNREFUSED;
+    if (refused) err = send(dest);  // the report cleared the error: send this one
+    if (err == 0) {
       ++counters_.datagrams_sent;
+      if (refused) {
+        ++counters_.no_listener;
+        if (status == Status::kSent) status = Status::kSentNoListener;
+      }
       continue;
     }
-    all = false;
-    const int err = n < 0 ? errno : EMSGSIZE;
+    status = Status::kFailed;
     if (err == EAGAIN || err == EWOULDBLOCK || err == ENOBUFS) {
       ++counters_.would_block;
     } else if (err == ECONNREFUSED) {
@@ -116,7 +125,7 @@ bool UdpPublisher::publish(const client::JointsMessage& msg) noexcept {
       ++counters_.other_errors;
     }
   }
-  return all;
+  return status;
 }
 
 }  // namespace mocap::publish

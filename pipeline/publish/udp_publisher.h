@@ -25,9 +25,10 @@ namespace mocap::publish {
 struct UdpPublisherCounters {
   std::uint64_t messages = 0;         // publish() calls
   std::uint64_t datagrams_sent = 0;   // successful sendto()s (messages x destinations)
+  std::uint64_t no_listener = 0;      // datagrams sent while the destination had no listener
   std::uint64_t encode_failures = 0;  // joint_count > kMaxJoints
   std::uint64_t would_block = 0;      // EAGAIN/EWOULDBLOCK/ENOBUFS: socket buffer full
-  std::uint64_t refused = 0;          // ECONNREFUSED (ICMP port unreachable reported)
+  std::uint64_t refused = 0;          // ECONNREFUSED twice in a row: the datagram was lost
   std::uint64_t other_errors = 0;     // any other errno
 };
 
@@ -49,8 +50,16 @@ class UdpPublisher {
   UdpPublisher& operator=(const UdpPublisher&) = delete;
   ~UdpPublisher();
 
-  // True when the datagram went to every destination.
-  bool publish(const client::JointsMessage& msg) noexcept;
+  enum class Status : std::uint8_t {
+    kSent,            // every destination took the datagram
+    kSentNoListener,  // sent everywhere, but a destination reported no listener (ICMP)
+    kFailed,          // at least one destination's datagram was not sent (counted)
+  };
+  // A connected UDP socket reports the ICMP port unreachable of an earlier datagram as
+  // ECONNREFUSED on the next sendto(), which then sends nothing; the report clears the
+  // error, so the datagram is sent again once: a tracker without a listener yet keeps
+  // sending every frame (two syscalls per frame) and a listener that starts gets all.
+  Status publish(const client::JointsMessage& msg) noexcept;
 
   std::size_t destination_count() const noexcept { return destinations_.size(); }
   const UdpPublisherCounters& counters() const noexcept { return counters_; }

@@ -19,20 +19,26 @@ class UdpSink final : public OutputSink {
   explicit UdpSink(UdpPublisher udp) : udp_(std::move(udp)) {}
   const char* name() const noexcept override { return "udp"; }
   bool publish(const FrameResult& frame) noexcept override {
-    const bool ok = udp_.publish(frame.joints);
-    (ok ? published_ : failures_).add();
-    return ok;
+    const UdpPublisher::Status s = udp_.publish(frame.joints);
+    if (s == UdpPublisher::Status::kFailed) {
+      failures_.add();
+      return false;
+    }
+    published_.add();
+    if (s == UdpPublisher::Status::kSentNoListener) no_listener_.add();
+    return true;
   }
   OutputCounters counters() const noexcept override {
     OutputCounters c;
     c.published = published_.get();
     c.failures = failures_.get();
+    c.no_listener = no_listener_.get();
     return c;
   }
 
  private:
   UdpPublisher udp_;
-  rt::Counter published_, failures_;
+  rt::Counter published_, failures_, no_listener_;
 };
 
 Expected<void> check_udp(const OutputRequest& r) {
@@ -72,6 +78,7 @@ Expected<OutputCreated> create_udp(const OutputRequest& r, const OutputContext&)
 
 extern const OutputKind kUdpOutput;
 const OutputKind kUdpOutput{"udp", "joint angles as UDP datagram v1 to HOST:PORT destinations",
+                            "multicast_if multicast_ttl",
                             &check_udp, &create_udp};
 
 }  // namespace mocap::publish

@@ -35,12 +35,14 @@ Expected<config::RunConfig> resolve_run_config(const std::string& path, const Cl
   if (cli.loop_frames) cfg.sim.loop_frames = *cli.loop_frames;
   if (cli.no_realtime) cfg.pipeline.realtime = false;
   if (cli.no_iceoryx) cfg.outputs.iceoryx = false;
-  for (const auto& [name, value] : cli.outputs) {
+  for (const auto& flag : cli.outputs) {  // a flag sets the value, keeps the options
+    const std::string& name = flag.first;
     auto& more = cfg.outputs.more;
-    more.erase(std::remove_if(more.begin(), more.end(),
-                              [&](const config::OutputEntry& e) { return e.name == name; }),
-               more.end());
-    more.push_back(config::OutputEntry{name, {value}, "--" + name});
+    auto it = std::find_if(more.begin(), more.end(),
+                           [&](const config::OutputEntry& e) { return e.name == name; });
+    if (it == more.end()) it = more.insert(more.end(), config::OutputEntry{name, {}, "", {}});
+    it->values = {flag.second};
+    it->where = "--" + name;
   }
   if (auto r = publish::check_outputs(output_requests(cfg, cli)); !r) return r.error();
   return cfg;
@@ -56,7 +58,7 @@ std::vector<publish::OutputRequest> output_requests(const config::RunConfig& cfg
   v.push_back(std::move(udp));
   v.push_back({"iceoryx", {cfg.outputs.iceoryx ? "true" : "false"}, file + ".iceoryx", {}});
   for (const config::OutputEntry& e : cfg.outputs.more)
-    v.push_back({e.name, e.values, e.where, {}});
+    v.push_back({e.name, e.values, e.where, e.options});
   return v;
 }
 

@@ -214,15 +214,36 @@ void read_outputs(const std::string& file, const YAML::Node& node, OutputSetting
       OutputEntry e;
       e.name = key;
       e.where = file + ": outputs." + key + line_suffix(kv.second);
-      if (kv.second.IsSequence()) {
-        for (std::size_t i = 0; i < kv.second.size(); ++i)
-          e.values.push_back(
-              formats_detail::get_string(kv.second[i], index_path("outputs." + key, i)));
-      } else if (kv.second.IsScalar()) {
-        e.values.push_back(formats_detail::get_string(kv.second, "outputs." + key));
+      // reset(), never operator=: assigning a YAML::Node writes into the node it refers to.
+      YAML::Node value;
+      value.reset(kv.second);
+      std::string path = "outputs." + key;
+      if (kv.second.IsMap()) {  // {value: V, option: X, ...}
+        formats_detail::check_unique_keys(kv.second, path);
+        bool has_value = false;
+        for (const auto& opt : kv.second) {
+          const std::string k = formats_detail::get_string(opt.first, path);
+          if (k == "value") {
+            value.reset(opt.second);
+            has_value = true;
+            continue;
+          }
+          if (!opt.second.IsScalar())
+            fail(path + "." + k, "expected a value, got " + formats_detail::describe(opt.second) +
+                                     line_suffix(opt.second));
+          e.options.emplace_back(k, formats_detail::get_string(opt.second, path + "." + k));
+        }
+        if (!has_value) fail(path, "the map form needs a 'value'" + line_suffix(kv.second));
+        path += ".value";
+      }
+      if (value.IsSequence()) {
+        for (std::size_t i = 0; i < value.size(); ++i)
+          e.values.push_back(formats_detail::get_string(value[i], index_path(path, i)));
+      } else if (value.IsScalar()) {
+        e.values.push_back(formats_detail::get_string(value, path));
       } else {
-        fail("outputs." + key, "expected a value or a list of values, got " +
-                                   formats_detail::describe(kv.second) + line_suffix(kv.second));
+        fail(path, "expected a value or a list of values, got " +
+                       formats_detail::describe(value) + line_suffix(value));
       }
       o.more.push_back(std::move(e));
     }

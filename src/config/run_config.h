@@ -73,6 +73,9 @@ struct OutputEntry {
   std::string name;                 // the key: the registry's output name
   std::vector<std::string> values;  // a scalar: one value; a list: one per item
   std::string where;                // "FILE: outputs.NAME (line N)" for error messages
+  // The map form `NAME: {value: V, KEY: VALUE, ...}`: every key but `value`, in file
+  // order (checked against the output's option keys by the registry).
+  std::vector<std::pair<std::string, std::string>> options;
 };
 
 struct OutputSettings {

@@ -5,16 +5,52 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <utility>
+#include <vector>
 
 #include "discover/body_builder_detail.h"
 
 namespace mocap::discover::detail {
 namespace {
 
+// The merge tolerances of a constant relative pose: one body seen twice keeps its
+// relative pose within the pose noise of two fits, far below these.
+constexpr double kSameRotationDeg = 1.0;
+constexpr double kSameTranslationMm = 2.0;
+
+// True when every relative pose in `rel` is T_ab within the tolerances above.
+bool all_within(const std::vector<Iso3>& rel, const Iso3& T_ab) {
+  for (const Iso3& T : rel) {
+    if (Eigen::AngleAxisd(T.linear() * T_ab.linear().transpose()).angle() * kDegPerRad >
+            kSameRotationDeg ||
+        (T.translation() - T_ab.translation()).norm() > kSameTranslationMm)
+      return false;
+  }
+  return true;
+}
+
+// T_world_A^-1 * T_world_B in every frame where both are posed.
+std::vector<Iso3> relative_poses(const DiscoveredBody& a, const DiscoveredBody& b) {
+  std::vector<Iso3> rel;
+  for (std::size_t f = 0; f < a.found.size() && f < b.found.size(); ++f)
+    if (a.found[f] && b.found[f]) rel.push_back(a.T_world_body[f].inverse() * b.T_world_body[f]);
+  return rel;
+}
+
+// The marker of `markers` nearest to X (index, distance); index -1 when there is none.
+std::pair<int, double> nearest_marker(const std::vector<Vec3>& markers, const Vec3& X) {
+  std::pair<int, double> best{-1, 1e300};
+  for (std::size_t k = 0; k < markers.size(); ++k) {
+    const double d = (markers[k] - X).norm();
+    if (d < best.second) best = {static_cast<int>(k), d};
+  }
+  return best;
+}
+
 // The same body built twice from clusters of different time windows (occlusions cut
 // every track between them): B is A when A's target, identified among B's tracks (and
 // B's among A's), keeps one constant pose relative to B (rotation within 1 deg,
-// translation within 2 mm) over at least min_covisible_frames frames in which A turned
+// translation within 2 mm: kSameRotationDeg, kSameTranslationMm) over at least min_covisible_frames frames in which A turned
 // by min_pair_rotation_deg. B's markers then join A's (or are left to the pool).
 // Pose-based test (above); returns false when it cannot decide or says no.
 bool same_by_poses(const Builder& A, const Builder& B, Iso3& T_ab) {
@@ -26,17 +62,9 @@ bool same_by_poses(const Builder& A, const Builder& B, Iso3& T_ab) {
     if (a.body.found[f] && b.body.found[f]) fs.push_back(static_cast<int>(f));
   if (static_cast<int>(fs.size()) < A.opt.min_covisible_frames) return false;
   if (a.rotation_range_deg(fs) < A.opt.min_pair_rotation_deg) return false;
-  std::vector<Iso3> rel;
-  for (int f : fs)
-    rel.push_back(a.body.T_world_body[static_cast<std::size_t>(f)].inverse() *
-                  b.body.T_world_body[static_cast<std::size_t>(f)]);
+  const std::vector<Iso3> rel = relative_poses(a.body, b.body);
   T_ab = rel[rel.size() / 2];
-  for (const Iso3& T : rel) {
-    if (Eigen::AngleAxisd(T.linear() * T_ab.linear().transpose()).angle() * kDegPerRad > 1.0)
-      return false;
-    if ((T.translation() - T_ab.translation()).norm() > 2.0) return false;
-  }
-  return true;
+  return all_within(rel, T_ab);
 }
 
 // Shape-based test (bodies mostly posed in different time windows):
@@ -71,9 +99,7 @@ bool same_by_shape(const Builder& A, const Builder& B, Iso3& T_ab) {
               double sum2 = 0.0;
               bool conflict = false;
               for (std::size_t m = 0; m < nb; ++m) {
-                double d_min = 1e300;
-                for (std::size_t n = 0; n < na; ++n)
-                  d_min = std::min(d_min, (T * mb[m] - ma[n]).norm());
+                const double d_min = nearest_marker(ma, T * mb[m]).second;
                 if (d_min <= tol) {
                   ++matched;
                   sum2 += d_min * d_min;
@@ -91,14 +117,7 @@ bool same_by_shape(const Builder& A, const Builder& B, Iso3& T_ab) {
             }
   if (best < 3) return false;
   // Frames where both are posed must show that same relative pose (else: two bodies).
-  for (std::size_t f = 0; f < A.frames(); ++f) {
-    if (!A.body.found[f] || !B.body.found[f]) continue;
-    const Iso3 T = A.body.T_world_body[f].inverse() * B.body.T_world_body[f];
-    if (Eigen::AngleAxisd(T.linear() * T_ab.linear().transpose()).angle() * kDegPerRad > 1.0 ||
-        (T.translation() - T_ab.translation()).norm() > 2.0)
-      return false;
-  }
-  return true;
+  return all_within(relative_poses(A.body, B.body), T_ab);
 }
 
 // Coincidence test (bodies posed together, e.g. a still torso whose tracks were cut
@@ -108,32 +127,17 @@ bool same_by_shape(const Builder& A, const Builder& B, Iso3& T_ab) {
 // half-way (within one marker diameter but not on a marker). Two distinct bodies cannot
 // hold markers at the same place at the same time, so this needs no motion.
 bool same_by_coincidence(const Builder& A, const Builder& B, Iso3& T_ab) {
-  std::vector<Iso3> rel;
-  for (std::size_t f = 0; f < A.frames(); ++f)
-    if (A.body.found[f] && B.body.found[f])
-      rel.push_back(A.body.T_world_body[f].inverse() * B.body.T_world_body[f]);
+  const std::vector<Iso3> rel = relative_poses(A.body, B.body);
   if (static_cast<int>(rel.size()) < A.opt.min_covisible_frames) return false;
   T_ab = rel[rel.size() / 2];
-  for (const Iso3& T : rel)
-    if (Eigen::AngleAxisd(T.linear() * T_ab.linear().transpose()).angle() * kDegPerRad > 1.0 ||
-        (T.translation() - T_ab.translation()).norm() > 2.0)
-      return false;
+  if (!all_within(rel, T_ab)) return false;
   const double tol = 4.0 * A.opt.body_fit_tolerance_mm();
   std::vector<char> taken(A.body.markers_body.size(), 0);
   int on = 0;
   for (const Vec3& m : B.body.markers_body) {
-    const Vec3 X_a = T_ab * m;
-    std::size_t nearest = 0;
-    double d_min = 1e300;
-    for (std::size_t k = 0; k < A.body.markers_body.size(); ++k) {
-      const double d = (A.body.markers_body[k] - X_a).norm();
-      if (d < d_min) {
-        d_min = d;
-        nearest = k;
-      }
-    }
-    if (d_min <= tol && !taken[nearest]) {
-      taken[nearest] = 1;
+    const auto [nearest, d_min] = nearest_marker(A.body.markers_body, T_ab * m);
+    if (nearest >= 0 && d_min <= tol && !taken[static_cast<std::size_t>(nearest)]) {
+      taken[static_cast<std::size_t>(nearest)] = 1;
       ++on;
     } else if (d_min < A.opt.marker_diameter_mm) {
       return false;
@@ -150,15 +154,7 @@ bool merge_if_same(Builder& A, const Builder& B, std::vector<int>& released) {
     return false;
   for (std::size_t m = 0; m < B.body.markers_body.size(); ++m) {
     const Vec3 X_a = T_ab * B.body.markers_body[m];
-    int nearest = -1;
-    double d_min = 1e300;
-    for (std::size_t k = 0; k < A.body.markers_body.size(); ++k) {
-      const double d = (A.body.markers_body[k] - X_a).norm();
-      if (d < d_min) {
-        d_min = d;
-        nearest = static_cast<int>(k);
-      }
-    }
+    const auto [nearest, d_min] = nearest_marker(A.body.markers_body, X_a);
     const auto& tracks_m = B.body.marker_tracks[m];
     bool coexists = false;
     if (nearest >= 0)

@@ -81,7 +81,9 @@ Expected<DiscoverResult> discover_model(const PointSequence& seq, const Discover
     return Error{label + ": no 3D marker point in any frame (no marker seen by both cameras)"};
   auto t0 = std::chrono::steady_clock::now();
 
-  const std::vector<PointTrack> tracks = point_tracks(seq, opt);
+  TrackedPoints points = point_tracks(seq, opt);
+  const std::vector<PointTrack> tracks = std::move(points.tracks);
+  opt.point_noise_mm = points.point_noise_mm;  // the later steps' noise
   st.point_noise_mm = opt.point_noise_mm;
   st.tracks = static_cast<int>(tracks.size());
   for (const PointTrack& t : tracks) st.long_tracks += t.seen >= opt.min_track_frames ? 1 : 0;

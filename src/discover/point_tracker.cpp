@@ -88,7 +88,8 @@ std::vector<PointTrack> track_points(const PointSequence& seq, const DiscoverOpt
     for (std::size_t t = 0; t < nt; ++t) {
       const auto [p, b1, b2] = best_two(np, [&](std::size_t i) { return d[t * np + i]; });
       if (p == np) continue;
-      const auto [t2, c1, c2] = best_two(nt, [&](std::size_t i) { return d[i * np + p]; });
+      const std::size_t point = p;  // (a lambda may not capture a structured binding in C++17)
+      const auto [t2, c1, c2] = best_two(nt, [&](std::size_t i) { return d[i * np + point]; });
       if (t2 == t && clear(b1, b2) && clear(c1, c2))
         point_track[p] = static_cast<int>(t);
       else
@@ -170,13 +171,14 @@ std::vector<PointTrack> stitch_still_fragments(std::vector<PointTrack> tracks,
   return out;
 }
 
-std::vector<PointTrack> point_tracks(const PointSequence& seq, DiscoverOptions& opt) {
+TrackedPoints point_tracks(const PointSequence& seq, const DiscoverOptions& options) {
+  DiscoverOptions opt = options;
   if (!(opt.point_noise_mm > 0.0)) {
     DiscoverOptions first = opt;
     first.point_noise_mm = opt.provisional_noise_mm;
     opt.point_noise_mm = estimate_point_noise(track_points(seq, first), first.point_noise_mm);
   }
-  return stitch_still_fragments(track_points(seq, opt), opt);
+  return {stitch_still_fragments(track_points(seq, opt), opt), opt.point_noise_mm};
 }
 
 double estimate_point_noise(const std::vector<PointTrack>& tracks, double fallback) {

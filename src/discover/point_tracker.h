@@ -22,10 +22,15 @@ namespace mocap::discover {
 std::vector<PointTrack> track_points(const PointSequence& points, const DiscoverOptions& options);
 
 // Step 1b as discover runs it: with options.point_noise_mm = 0 (auto), a first pass with
-// provisional_noise_mm gates, the noise estimated from its tracks (estimate_point_noise)
-// and written to options.point_noise_mm, then the pass with that noise; still markers'
-// fragments stitched (stitch_still_fragments).
-std::vector<PointTrack> point_tracks(const PointSequence& points, DiscoverOptions& options);
+// provisional_noise_mm gates and the noise estimated from its tracks
+// (estimate_point_noise), then the pass with that noise; still markers' fragments
+// stitched (stitch_still_fragments). Returns the tracks and the noise they were made
+// with (options.point_noise_mm when it was given).
+struct TrackedPoints {
+  std::vector<PointTrack> tracks;
+  double point_noise_mm = 0.0;
+};
+TrackedPoints point_tracks(const PointSequence& points, const DiscoverOptions& options);
 
 // Re-links the fragments of a still marker: a marker that stands still (a still torso)
 // but is hidden now and then (an arm passing in front) leaves one track per visible

@@ -23,7 +23,7 @@ int main(int argc, char** argv) {
     if (const char* dump = std::getenv("DISCOVER_DUMP_TRACKS")) {  // tracks for analysis
       FILE* out = std::fopen(dump, "w");
       mocap::discover::DiscoverOptions opt;
-      const auto tracks = mocap::discover::point_tracks(*points, opt);
+      const auto tracks = mocap::discover::point_tracks(*points, opt).tracks;
       for (std::size_t k = 0; k < tracks.size(); ++k)
         for (int f = tracks[k].first; f <= tracks[k].last(); ++f)
           if (tracks[k].has(f))

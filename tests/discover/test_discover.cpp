@@ -31,9 +31,10 @@ void expect_tracks_stay_on_one_marker(const std::string& rec,
   std::map<std::int64_t, std::vector<const GtMarker*>> by_frame;
   for (const GtMarker& m : *gt) by_frame[m.frame].push_back(&m);
   discover::DiscoverOptions opt;
-  const auto tracks = discover::point_tracks(points, opt);  // still fragments stitched
-  EXPECT_GT(opt.point_noise_mm, 0.005);                     // estimated from the tracks
-  EXPECT_LT(opt.point_noise_mm, 0.1);
+  const auto tracked = discover::point_tracks(points, opt);  // still fragments stitched
+  const auto& tracks = tracked.tracks;
+  EXPECT_GT(tracked.point_noise_mm, 0.005);  // estimated from the tracks
+  EXPECT_LT(tracked.point_noise_mm, 0.1);
   int long_tracks = 0, switches = 0, labelled = 0;
   for (const auto& t : tracks) {
     if (t.seen < opt.min_track_frames) continue;

@@ -8,10 +8,7 @@
 //  3. `run --config` with the calibrated rig and the discovered targets and model, its
 //     UDP datagrams received here;
 //  4. the angles match the simulator's truth (angle_truth.h).
-#include <arpa/inet.h>
 #include <gtest/gtest.h>
-#include <netinet/in.h>
-#include <sys/socket.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -24,6 +21,7 @@
 #include "angle_truth.h"
 #include "client/datagram.h"
 #include "tests/support/test_support.h"
+#include "tests/support/udp_port.h"
 
 namespace mocap {
 namespace {
@@ -87,18 +85,8 @@ TEST(Walkthrough, FromNothingToJointAnglesOnSimulatedCameras) {
 
   // 3. Live tracking with the results; the angles arrive over UDP. A socket of our own
   // keeps every datagram (a client::UdpReceiver keeps the latest only).
-  const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
-  ASSERT_GE(fd, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  ASSERT_EQ(::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a), 0);
-  socklen_t alen = sizeof a;
-  ASSERT_EQ(::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &alen), 0);
-  const int rcvbuf = 1 << 20;  // 150 datagrams of < 1 KB even if this thread is late
-  ::setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &rcvbuf, sizeof rcvbuf);
-  timeval tv{0, 50'000};
-  ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+  const test::KeepAllUdpSocket udp(50'000);
+  ASSERT_TRUE(udp.ok());
   const std::string run_cfg =
       camera_config(dir, "run", f("scene_robot"),
                     "rig: rig.yaml\ntargets: found/targets.yaml\nmodel: found/model.yaml\n");
@@ -106,7 +94,7 @@ TEST(Walkthrough, FromNothingToJointAnglesOnSimulatedCameras) {
   std::atomic<bool> run_done{false};
   std::thread runner([&] {
     run = run_mocap("run --config " + run_cfg + " --udp 127.0.0.1:" +
-                        std::to_string(ntohs(a.sin_port)) + " --duration 2 --stats-interval 0",
+                        std::to_string(udp.port()) + " --duration 2 --stats-interval 0",
                     60);
     run_done.store(true, std::memory_order_release);  // `run` is complete
   });
@@ -120,7 +108,7 @@ TEST(Walkthrough, FromNothingToJointAnglesOnSimulatedCameras) {
   std::uint8_t buf[client::kMaxDatagramBytes + 1];
   client::JointsMessage m;
   while (std::chrono::steady_clock::now() < until && sequences.size() < 150) {
-    const ssize_t n = ::recv(fd, buf, sizeof buf, 0);
+    const ssize_t n = udp.receive(buf, sizeof buf);
     if (n <= 0) {
       if (run_done.load(std::memory_order_acquire)) break;  // ended, nothing pending
       continue;
@@ -139,13 +127,12 @@ TEST(Walkthrough, FromNothingToJointAnglesOnSimulatedCameras) {
       row.timestamp_ns = m.capture_ns;
       row.type = jr.type == static_cast<std::uint8_t>(client::JointKind::kHinge) ? JointType::kHinge
                                                                                  : JointType::kBall;
-      row.angles_deg = Vec3(jr.a[0], jr.a[1], jr.a[2]) * kDegPerRad;
-      row.q_parent_child = Quat(jr.q[0], jr.q[1], jr.q[2], jr.q[3]);
+      row.angles_deg = Eigen::Vector3f(jr.a[0], jr.a[1], jr.a[2]).cast<double>() * kDegPerRad;
+      row.q_parent_child = Eigen::Quaternionf(jr.q[0], jr.q[1], jr.q[2], jr.q[3]).cast<double>();
       found.push_back(row);
     }
   }
   runner.join();
-  ::close(fd);
   ASSERT_EQ(run.exit_code, 0) << run.output;
   EXPECT_GE(sequences.size(), 145U);  // every frame of the recording, UDP on loopback
 

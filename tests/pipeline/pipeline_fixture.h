@@ -146,7 +146,9 @@ class UdpPublisherSink final : public publish::OutputSink {
   explicit UdpPublisherSink(publish::UdpPublisher p) : p_(std::move(p)) {}
   const char* name() const noexcept override { return "udp"; }
   publish::OutputCounters counters() const noexcept override { return {}; }
-  bool publish(const publish::FrameResult& f) noexcept override { return p_.publish(f.joints); }
+  bool publish(const publish::FrameResult& f) noexcept override {
+    return p_.publish(f.joints) != publish::UdpPublisher::Status::kFailed;
+  }
   const publish::UdpPublisher& publisher() const { return p_; }
 
  private:

@@ -73,6 +73,32 @@ TEST(OutputRegistry, UdpAndIceoryxWithoutRouDiGiveOneSinkAndOneNotice) {
   EXPECT_FLOAT_EQ(rx->latest().joints[0].a[0], 0.5f);
 }
 
+// No listener on the destination is not a failure: every frame is published and the
+// refusals (ICMP port unreachable on loopback) are counted as no_listener.
+TEST(OutputRegistry, UdpWithoutListenerPublishesEveryFrame) {
+  std::uint16_t port = 0;
+  {
+    auto gone = mocap::client::UdpReceiver::create("127.0.0.1:0");  // a port, then closed
+    ASSERT_TRUE(gone.ok());
+    port = gone->port();
+  }
+  std::vector<OutputRequest> req = {
+      {"udp", {"127.0.0.1:" + std::to_string(port)}, "test: outputs.udp", {}}};
+  auto outs = mocap::publish::create_outputs(req, {});
+  ASSERT_TRUE(outs.ok()) << outs.error().message;
+  ASSERT_EQ(outs->sinks.size(), 1u);
+  auto frame = std::make_unique<mocap::publish::FrameResult>();
+  frame->joints.joint_count = 1;
+  for (std::uint64_t s = 1; s <= 30; ++s) {
+    frame->joints.sequence = s;
+    EXPECT_TRUE(outs->sinks[0]->publish(*frame)) << s;
+  }
+  const auto c = outs->sinks[0]->counters();
+  EXPECT_EQ(c.published, 30u);
+  EXPECT_EQ(c.failures, 0u);
+  EXPECT_GT(c.no_listener, 0u);
+}
+
 TEST(OutputRegistry, DisabledOutputsBuildNothing) {
   std::vector<OutputRequest> req = {{"udp", {}, "t: outputs.udp", {}},
                                     {"iceoryx", {"false"}, "t: outputs.iceoryx", {}}};
@@ -101,6 +127,14 @@ TEST(OutputRegistry, BadRequestsFailWithOneLine) {
   e = check({"udp", {"h:1"}, "--udp", {{"multicast_ttl", "300"}}});
   ASSERT_FALSE(e.ok());
   EXPECT_EQ(e.error().message, "--udp: multicast ttl: must be in 0..255, got '300'");
+  e = check({"udp", {"h:1"}, "run.yaml: outputs.udp", {{"multicast_tll", "3"}}});
+  ASSERT_FALSE(e.ok());
+  EXPECT_EQ(e.error().message, "run.yaml: outputs.udp: multicast_tll: unknown option (known: "
+                               "multicast_if multicast_ttl)");
+  e = check({"ros2", {"true"}, "run.yaml: outputs.ros2", {{"domain_id", "x"}}});
+  ASSERT_FALSE(e.ok());
+  EXPECT_EQ(e.error().message,
+            "run.yaml: outputs.ros2: domain_id: expected an integer in 0..232, got 'x'");
   for (const auto& m : {e.error().message}) EXPECT_EQ(m.find('\n'), std::string::npos);
 }
 

@@ -183,9 +183,16 @@ TEST(Ros2Mapping, NamesAsTheUrdfAndDomainAndStamp) {
 }
 
 TEST(Ros2Output, BadDomainIsOneLineNamingTheVariable) {
-  auto e = check_outputs({{"ros2", {"true"}, "--ros2", {{"domain_id", "x7"}}}});
+  ::setenv("ROS_DOMAIN_ID", "x7", 1);
+  auto e = check_outputs({{"ros2", {"true"}, "--ros2", {}}});
+  ::unsetenv("ROS_DOMAIN_ID");
   ASSERT_FALSE(e.ok());
   EXPECT_EQ(e.error().message, "ROS_DOMAIN_ID: 'x7': expected an integer in 0..232");
+  // The configuration's outputs.ros2.domain_id wins over the environment.
+  e = check_outputs({{"ros2", {"true"}, "m.yaml: outputs.ros2", {{"domain_id", "233"}}}});
+  ASSERT_FALSE(e.ok());
+  EXPECT_EQ(e.error().message,
+            "m.yaml: outputs.ros2: domain_id: expected an integer in 0..232, got '233'");
   EXPECT_FALSE(check_outputs({{"ros2", {"perhaps"}, "--ros2", {}}}).ok());
 }
 

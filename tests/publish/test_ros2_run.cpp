@@ -6,11 +6,8 @@
 // datagrams' angles (frames aligned by capture time: stamp - capture_ns is one constant
 // offset), the names are the revolute joints of the URDF the tracker publishes on
 // /robot_description (transient local), and the run reports the ros2 counters.
-#include <arpa/inet.h>
 #include <dds/dds.h>
 #include <gtest/gtest.h>
-#include <netinet/in.h>
-#include <sys/socket.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -23,6 +20,7 @@
 #include "client/datagram.h"
 #include "ros2_msgs.h"
 #include "tests/support/test_support.h"
+#include "tests/support/udp_port.h"
 
 namespace mocap {
 namespace {
@@ -36,16 +34,8 @@ struct JsRecord {
 TEST(Ros2Run, TrackerPublishesEveryFrameOnJointStatesAndTf) {
   const std::uint32_t domain = static_cast<std::uint32_t>(10 + ::getpid() % 80);
   // The UDP side: a socket of our own, every datagram kept.
-  const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
-  ASSERT_GE(fd, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  ASSERT_EQ(::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a), 0);
-  socklen_t alen = sizeof a;
-  ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &alen);
-  timeval tv{0, 20'000};
-  ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+  const test::KeepAllUdpSocket udp_rx(20'000);
+  ASSERT_TRUE(udp_rx.ok());
   // The DDS side.
   const dds_entity_t pp = dds_create_participant(domain, nullptr, nullptr);
   ASSERT_GT(pp, 0);
@@ -80,7 +70,7 @@ TEST(Ros2Run, TrackerPublishesEveryFrameOnJointStatesAndTf) {
                             test::mocap_binary() +
                             " run --ros2 --duration 2 --rate 100 --loop-frames 4 --no-realtime "
                             "--no-iceoryx --stats-interval 0 --udp 127.0.0.1:" +
-                            std::to_string(ntohs(a.sin_port)) + " --stats " + stats + " 2>&1");
+                            std::to_string(udp_rx.port()) + " --stats " + stats + " 2>&1");
   });
   std::vector<client::JointsMessage> udp;
   std::vector<JsRecord> states;
@@ -135,7 +125,7 @@ TEST(Ros2Run, TrackerPublishesEveryFrameOnJointStatesAndTf) {
     }
   };
   while (!done && std::chrono::steady_clock::now() < deadline) {
-    const ssize_t n = ::recv(fd, buf, sizeof buf, 0);
+    const ssize_t n = udp_rx.receive(buf, sizeof buf);
     if (n > 0) {
       client::JointsMessage m;
       if (client::decode_datagram(buf, static_cast<std::size_t>(n), m) == client::DecodeStatus::kOk)
@@ -160,7 +150,6 @@ TEST(Ros2Run, TrackerPublishesEveryFrameOnJointStatesAndTf) {
   }
   tracker.join();
   drain_dds();
-  ::close(fd);
   dds_delete(pp);
   ASSERT_EQ(run.exit_code, 0) << run.output;
   ASSERT_TRUE(matched) << run.output;

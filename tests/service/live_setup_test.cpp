@@ -99,12 +99,33 @@ TEST(LiveSetup, RegistryOutputsFromTheFileAndTheFlags) {
             0u)
       << bad.error().message;
   EXPECT_EQ(check_config_command(dir.file("bad.yaml")), 1);
+  // The map form: `value` plus options, checked against the output's option keys.
   test::write_file(dir.file("map.yaml"), "outputs:\n  ros2: {a: 1}\n");
   auto map = resolve_run_config(dir.file("map.yaml"), CliOverrides{});
   ASSERT_FALSE(map);
-  EXPECT_NE(map.error().message.find("outputs.ros2: expected a value or a list of values"),
+  EXPECT_EQ(map.error().message, dir.file("map.yaml") + ": outputs.ros2: the map form needs a "
+                                                        "'value' (line 2)");
+  test::write_file(dir.file("opt.yaml"), "outputs:\n  ros2: {value: false, domain_id: 7}\n");
+  auto opt = resolve_run_config(dir.file("opt.yaml"), CliOverrides{});
+  ASSERT_TRUE(opt) << opt.error().message;
+  ASSERT_EQ(opt->outputs.more.size(), 1u);
+  EXPECT_EQ(opt->outputs.more[0].values, std::vector<std::string>{"false"});
+  using Options = std::vector<std::pair<std::string, std::string>>;
+  EXPECT_EQ(opt->outputs.more[0].options, (Options{{"domain_id", "7"}}));
+  auto with_flag = resolve_run_config(dir.file("opt.yaml"), cli);  // --ros2 keeps domain_id
+  ASSERT_TRUE(with_flag) << with_flag.error().message;
+  EXPECT_EQ(output_requests(*with_flag, cli)[2].options, (Options{{"domain_id", "7"}}));
+  test::write_file(dir.file("typo.yaml"), "outputs:\n  ros2: {value: false, domain: 7}\n");
+  auto typo = resolve_run_config(dir.file("typo.yaml"), CliOverrides{});
+  ASSERT_FALSE(typo);
+  EXPECT_EQ(typo.error().message, dir.file("typo.yaml") + ": outputs.ros2 (line 2): domain: "
+                                                          "unknown option (known: domain_id)");
+  test::write_file(dir.file("deep.yaml"), "outputs:\n  ros2: {value: false, domain_id: [1]}\n");
+  auto deep = resolve_run_config(dir.file("deep.yaml"), CliOverrides{});
+  ASSERT_FALSE(deep);
+  EXPECT_NE(deep.error().message.find("outputs.ros2.domain_id: expected a value, got"),
             std::string::npos)
-      << map.error().message;
+      << deep.error().message;
 }
 
 TEST(LiveSetup, ReplayCamerasConfiguredFromTheFile) {

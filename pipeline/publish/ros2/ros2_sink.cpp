@@ -12,7 +12,7 @@
 //                    calibrated model is loaded.
 // QoS: ROS 2's default (reliable, keep last 10, volatile); robot_description: reliable,
 // keep last 1, transient local (as robot_state_publisher publishes it). Domain:
-// ROS_DOMAIN_ID (default 0), or the request option domain_id (tests).
+// ROS_DOMAIN_ID (default 0), or the request option domain_id (outputs.ros2.domain_id).
 // header.stamp: the frame's capture time (CLOCK_MONOTONIC) + the CLOCK_REALTIME offset
 // measured at start. The message buffers are built once; encode() only fills them.
 // Missing DDS at runtime (no participant): no sink, one notice line; tracker continues.
@@ -166,7 +166,11 @@ class Ros2Sink final : public QueuedSink {
 };
 
 Expected<std::uint32_t> domain_of(const OutputRequest& r) {
-  if (const std::string* d = r.option("domain_id")) return ros2::parse_domain_id(d->c_str());
+  if (const std::string* d = r.option("domain_id")) {
+    auto id = ros2::parse_domain_id(d->c_str());
+    if (!id || d->empty()) return make_error(r.where, "domain_id", "expected an integer in 0..232, got '" + *d + "'");
+    return id;
+  }
   return ros2::parse_domain_id(std::getenv("ROS_DOMAIN_ID"));
 }
 
@@ -198,6 +202,7 @@ Expected<OutputCreated> create_ros2(const OutputRequest& r, const OutputContext&
 
 extern const OutputKind kRos2Output;
 const OutputKind kRos2Output{"ros2", "ROS 2 /joint_states and /tf over DDS (Cyclone DDS)",
+                             "domain_id",
                              &check_ros2, &create_ros2};
 
 }  // namespace mocap::publish
