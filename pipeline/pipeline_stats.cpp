@@ -125,8 +125,7 @@ PipelineStats Pipeline::stats() const {
     const auto& joints = processor_.model().joints;
     for (std::size_t j = 0; j < joints.size() && 2 * j + 1 < kCoverageFields.size(); ++j) {
       s.counters.emplace_back("coverage_" + joints[j].name + "_poses", lib.coverage.get(2 * j));
-      s.counters.emplace_back("coverage_" + joints[j].name + "_chain",
-                              lib.coverage.get(2 * j + 1));
+      s.counters.emplace_back("coverage_" + joints[j].name + "_chain", lib.coverage.get(2 * j + 1));
     }
   }
   // Per output sink (the output seam): output_<name>_published/failures/dropped/no_listener.

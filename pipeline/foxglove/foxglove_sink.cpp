@@ -182,7 +182,6 @@ Expected<OutputCreated> create_foxglove(const OutputRequest& r, const OutputCont
 extern const OutputKind kFoxgloveOutput;
 const OutputKind kFoxgloveOutput{
     "foxglove", "Foxglove WebSocket live view on [ADDRESS:]PORT (docs/foxglove.md)",
-    "max_clients client_queue max_rate_hz",
-    &check_foxglove, &create_foxglove};
+    "max_clients client_queue max_rate_hz", &check_foxglove, &create_foxglove};
 
 }  // namespace mocap::publish

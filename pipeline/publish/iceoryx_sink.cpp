@@ -69,7 +69,6 @@ Expected<OutputCreated> create_iceoryx(const OutputRequest& r, const OutputConte
 
 extern const OutputKind kIceoryxOutput;
 const OutputKind kIceoryxOutput{"iceoryx", "joint angles over iceoryx shared memory (iox-roudi)",
-                                "app_name roudi_socket",
-                                &check_iceoryx, &create_iceoryx};
+                                "app_name roudi_socket", &check_iceoryx, &create_iceoryx};
 
 }  // namespace mocap::publish

@@ -30,9 +30,9 @@ struct OutputContext {
 
 // Counters every sink reports (read from other threads: relaxed snapshots).
 struct OutputCounters {
-  std::uint64_t published = 0;  // frames handed over to the transport / encoder
-  std::uint64_t failures = 0;   // frames the transport refused
-  std::uint64_t dropped = 0;    // frames dropped by a bounded queue (drop-oldest)
+  std::uint64_t published = 0;    // frames handed over to the transport / encoder
+  std::uint64_t failures = 0;     // frames the transport refused
+  std::uint64_t dropped = 0;      // frames dropped by a bounded queue (drop-oldest)
   std::uint64_t no_listener = 0;  // frames sent while a destination reported no listener
                                   // (UDP: ICMP port unreachable); not failures
 };

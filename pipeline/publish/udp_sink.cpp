@@ -78,7 +78,6 @@ Expected<OutputCreated> create_udp(const OutputRequest& r, const OutputContext&)
 
 extern const OutputKind kUdpOutput;
 const OutputKind kUdpOutput{"udp", "joint angles as UDP datagram v1 to HOST:PORT destinations",
-                            "multicast_if multicast_ttl",
-                            &check_udp, &create_udp};
+                            "multicast_if multicast_ttl", &check_udp, &create_udp};
 
 }  // namespace mocap::publish

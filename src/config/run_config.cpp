@@ -242,8 +242,8 @@ void read_outputs(const std::string& file, const YAML::Node& node, OutputSetting
       } else if (value.IsScalar()) {
         e.values.push_back(formats_detail::get_string(value, path));
       } else {
-        fail(path, "expected a value or a list of values, got " +
-                       formats_detail::describe(value) + line_suffix(value));
+        fail(path, "expected a value or a list of values, got " + formats_detail::describe(value) +
+                       line_suffix(value));
       }
       o.more.push_back(std::move(e));
     }

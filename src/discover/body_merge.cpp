@@ -50,9 +50,9 @@ std::pair<int, double> nearest_marker(const std::vector<Vec3>& markers, const Ve
 // The same body built twice from clusters of different time windows (occlusions cut
 // every track between them): B is A when A's target, identified among B's tracks (and
 // B's among A's), keeps one constant pose relative to B (rotation within 1 deg,
-// translation within 2 mm: kSameRotationDeg, kSameTranslationMm) over at least min_covisible_frames frames in which A turned
-// by min_pair_rotation_deg. B's markers then join A's (or are left to the pool).
-// Pose-based test (above); returns false when it cannot decide or says no.
+// translation within 2 mm: kSameRotationDeg, kSameTranslationMm) over at least min_covisible_frames
+// frames in which A turned by min_pair_rotation_deg. B's markers then join A's (or are left to the
+// pool). Pose-based test (above); returns false when it cannot decide or says no.
 bool same_by_poses(const Builder& A, const Builder& B, Iso3& T_ab) {
   Builder a = A, b = B;
   a.extend_poses(B.members);

@@ -93,8 +93,8 @@ TEST(Walkthrough, FromNothingToJointAnglesOnSimulatedCameras) {
   test::RunResult run;
   std::atomic<bool> run_done{false};
   std::thread runner([&] {
-    run = run_mocap("run --config " + run_cfg + " --udp 127.0.0.1:" +
-                        std::to_string(udp.port()) + " --duration 2 --stats-interval 0",
+    run = run_mocap("run --config " + run_cfg + " --udp 127.0.0.1:" + std::to_string(udp.port()) +
+                        " --duration 2 --stats-interval 0",
                     60);
     run_done.store(true, std::memory_order_release);  // `run` is complete
   });

@@ -4,10 +4,9 @@
 // per frame in steady state.
 #include <gtest/gtest.h>
 
-#include <limits>
-
 #include <Eigen/Eigenvalues>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <random>
 
@@ -188,7 +187,8 @@ TEST(Identifier, CountsOverflowAndInvalidPoints) {
   SceneOptions opt;
   opt.strays = 30;
   auto scene = make_scene(rng, set, opt);
-  scene.pts.insert(scene.pts.begin(), MeasuredPoint{Vec3(std::numeric_limits<double>::quiet_NaN(), 0, 0), {-1, -1}});
+  scene.pts.insert(scene.pts.begin(),
+                   MeasuredPoint{Vec3(std::numeric_limits<double>::quiet_NaN(), 0, 0), {-1, -1}});
   BodyPoses out;
   id->identify(scene.pts.data(), static_cast<int>(scene.pts.size()), 0, out);
   EXPECT_EQ(id->counters().point_overflow, scene.pts.size() - 20);

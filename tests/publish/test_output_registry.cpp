@@ -129,8 +129,9 @@ TEST(OutputRegistry, BadRequestsFailWithOneLine) {
   EXPECT_EQ(e.error().message, "--udp: multicast ttl: must be in 0..255, got '300'");
   e = check({"udp", {"h:1"}, "run.yaml: outputs.udp", {{"multicast_tll", "3"}}});
   ASSERT_FALSE(e.ok());
-  EXPECT_EQ(e.error().message, "run.yaml: outputs.udp: multicast_tll: unknown option (known: "
-                               "multicast_if multicast_ttl)");
+  EXPECT_EQ(e.error().message,
+            "run.yaml: outputs.udp: multicast_tll: unknown option (known: "
+            "multicast_if multicast_ttl)");
   e = check({"ros2", {"true"}, "run.yaml: outputs.ros2", {{"domain_id", "x"}}});
   ASSERT_FALSE(e.ok());
   EXPECT_EQ(e.error().message,

@@ -43,7 +43,8 @@ TEST(UdpMulticast, TwoReceiversInTheGroupGetEveryDatagramOnLoopback) {
   mc.interface = "127.0.0.1";
   auto pub = UdpPublisher::create({dest}, mc);
   ASSERT_TRUE(pub.ok()) << pub.error().message;
-  for (std::uint64_t s = 1; s <= 20; ++s) ASSERT_EQ(pub->publish(message(s)), mocap::publish::UdpPublisher::Status::kSent);
+  for (std::uint64_t s = 1; s <= 20; ++s)
+    ASSERT_EQ(pub->publish(message(s)), mocap::publish::UdpPublisher::Status::kSent);
 
   for (client::UdpReceiver* rx : {&rx1.value(), &rx2.value()}) {
     const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(2);

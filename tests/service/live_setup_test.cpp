@@ -69,8 +69,7 @@ TEST(LiveSetup, CommandLineOverridesTheFile) {
 
 TEST(LiveSetup, RegistryOutputsFromTheFileAndTheFlags) {
   test::TempDir dir("svc_outputs");
-  test::write_file(dir.file("o.yaml"),
-                   "outputs:\n  udp: []\n  iceoryx: false\n  ros2: false\n");
+  test::write_file(dir.file("o.yaml"), "outputs:\n  udp: []\n  iceoryx: false\n  ros2: false\n");
   auto cfg = resolve_run_config(dir.file("o.yaml"), CliOverrides{});
   ASSERT_TRUE(cfg) << cfg.error().message;
   ASSERT_EQ(cfg->outputs.more.size(), 1u);
@@ -103,8 +102,9 @@ TEST(LiveSetup, RegistryOutputsFromTheFileAndTheFlags) {
   test::write_file(dir.file("map.yaml"), "outputs:\n  ros2: {a: 1}\n");
   auto map = resolve_run_config(dir.file("map.yaml"), CliOverrides{});
   ASSERT_FALSE(map);
-  EXPECT_EQ(map.error().message, dir.file("map.yaml") + ": outputs.ros2: the map form needs a "
-                                                        "'value' (line 2)");
+  EXPECT_EQ(map.error().message, dir.file("map.yaml") +
+                                     ": outputs.ros2: the map form needs a "
+                                     "'value' (line 2)");
   test::write_file(dir.file("opt.yaml"), "outputs:\n  ros2: {value: false, domain_id: 7}\n");
   auto opt = resolve_run_config(dir.file("opt.yaml"), CliOverrides{});
   ASSERT_TRUE(opt) << opt.error().message;
@@ -118,8 +118,9 @@ TEST(LiveSetup, RegistryOutputsFromTheFileAndTheFlags) {
   test::write_file(dir.file("typo.yaml"), "outputs:\n  ros2: {value: false, domain: 7}\n");
   auto typo = resolve_run_config(dir.file("typo.yaml"), CliOverrides{});
   ASSERT_FALSE(typo);
-  EXPECT_EQ(typo.error().message, dir.file("typo.yaml") + ": outputs.ros2 (line 2): domain: "
-                                                          "unknown option (known: domain_id)");
+  EXPECT_EQ(typo.error().message, dir.file("typo.yaml") +
+                                      ": outputs.ros2 (line 2): domain: "
+                                      "unknown option (known: domain_id)");
   test::write_file(dir.file("deep.yaml"), "outputs:\n  ros2: {value: false, domain_id: [1]}\n");
   auto deep = resolve_run_config(dir.file("deep.yaml"), CliOverrides{});
   ASSERT_FALSE(deep);

@@ -168,7 +168,8 @@ class Ros2Sink final : public QueuedSink {
 Expected<std::uint32_t> domain_of(const OutputRequest& r) {
   if (const std::string* d = r.option("domain_id")) {
     auto id = ros2::parse_domain_id(d->c_str());
-    if (!id || d->empty()) return make_error(r.where, "domain_id", "expected an integer in 0..232, got '" + *d + "'");
+    if (!id || d->empty())
+      return make_error(r.where, "domain_id", "expected an integer in 0..232, got '" + *d + "'");
     return id;
   }
   return ros2::parse_domain_id(std::getenv("ROS_DOMAIN_ID"));
@@ -202,7 +203,6 @@ Expected<OutputCreated> create_ros2(const OutputRequest& r, const OutputContext&
 
 extern const OutputKind kRos2Output;
 const OutputKind kRos2Output{"ros2", "ROS 2 /joint_states and /tf over DDS (Cyclone DDS)",
-                             "domain_id",
-                             &check_ros2, &create_ros2};
+                             "domain_id", &check_ros2, &create_ros2};
 
 }  // namespace mocap::publish

@@ -1,0 +1,86 @@
+// Design: N-view correspondence for rigs with more than two cameras. The pairwise stereo
+// stage (stereo_triangulator.h, one per camera pair) proposes 2-view candidates; this
+// stage merges them into N-view points:
+//   1. every pairwise candidate is a hypothesis (its two blobs);
+//   2. each hypothesis is projected into every other camera; a blob within gate_px of
+//      the projection (real pixels) joins it as a further view;
+//   3. hypotheses with three or more views are refined over all of them (Gauss-Newton
+//      on the real-pixel reprojection error, nview.h); a view whose residual exceeds
+//      gate_px is dropped and the point refined again (an outlier never drags a point);
+//   4. hypotheses are taken in order of more views, then smaller RMS; one whose blobs
+//      are all used by a taken point is the same point seen by another pair (merged);
+//      one that shares a blob with a taken point seen by MORE cameras is a ghost,
+//      rejected through the third view; one that shares a blob with a taken point seen
+//      by as many cameras stays, and both are flagged ambiguous (not reported): the
+//      identification resolves them by evidence, exactly as for two cameras.
+// A 2-view point that no third camera confirms is still reported: under occlusion a
+// camera that should see a marker often does not, so absence is no evidence, and a
+// consistent pair of stray blobs is a point like any other for the identification,
+// which rejects what fits no target. With two cameras there is nothing to add: the
+// pair's candidates pass unchanged.
+// Capacity is fixed in create(); process() is noexcept and allocation-free; overflows
+// and rejections are counters. Each output point records its blob per camera.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "camera/camera_model.h"
+#include "core/expected.h"
+#include "stereo/stereo_types.h"
+
+namespace mocap {
+
+struct MultiViewConfig {
+  // A further view supports a point when one of its blobs lies within this distance of
+  // the point's projection, and a refined view must stay within it: the same bound as
+  // StereoConfig::max_reproj_px (real pixels), which the noise of a centroid (< 0.2 px)
+  // and the calibration error stay far below.
+  double gate_px = 2.0;
+  int max_points_per_camera = 256;  // blobs per camera considered (as StereoConfig)
+  int max_hypotheses = 2048;        // pairwise candidates considered per frame
+};
+
+struct MultiViewCounters {
+  std::uint64_t frames = 0;
+  std::uint64_t hypotheses = 0;           // pairwise candidates received
+  std::uint64_t hypothesis_overflow = 0;  // beyond max_hypotheses (dropped)
+  std::uint64_t views_added = 0;          // third and further views found by projection
+  std::uint64_t views_dropped = 0;        // views removed as outliers after refinement
+  std::uint64_t merged = 0;               // the same point from another camera pair
+  std::uint64_t ghosts_rejected = 0;      // lost to a point seen by more cameras
+  std::uint64_t ambiguous = 0;            // emitted points flagged ambiguous
+  std::uint64_t points = 0;               // emitted points
+  std::uint64_t point_overflow = 0;       // emitted points beyond the output's capacity
+};
+
+class MultiViewMerger {
+ public:
+  // Setup: 2..kMaxCameras cameras of the rig, a positive gate; allocates the workspace.
+  static Expected<MultiViewMerger> create(const Rig& rig, const MultiViewConfig& config);
+
+  // One frame. px[c][0..n[c]) are camera c's blob centroids (distorted pixels) for
+  // c < camera_count(); pairs[0..pair_count) the pairwise candidates (blob_index by the
+  // rig's camera index). Clears `out` and fills it. False when something was dropped
+  // (hypotheses or output capacity); what was written is valid either way.
+  bool process(const Vec2* const* px, const int* n, const PointList* const* pairs, int pair_count,
+               PointList& out) noexcept;
+
+  int camera_count() const noexcept { return static_cast<int>(cams_.size()); }
+  const MultiViewCounters& counters() const noexcept { return counters_; }
+
+ private:
+  MultiViewMerger(const Rig& rig, const MultiViewConfig& config);
+  void extend(Point3& h, const Vec2* const* px, const int* n) noexcept;
+  void refine(Point3& h, const Vec2* const* px) noexcept;
+
+  std::vector<CameraModel> cams_;
+  MultiViewConfig config_;
+  std::vector<Point3> hyp_;    // workspace: this frame's hypotheses
+  std::vector<int> views_;     // views per hypothesis
+  std::vector<int> order_;     // hypotheses in acceptance order
+  std::vector<int> taken_by_;  // [camera * max_points_per_camera + blob]: output index
+  MultiViewCounters counters_;
+};
+
+}  // namespace mocap
