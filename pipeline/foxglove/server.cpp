@@ -102,9 +102,9 @@ void Server::broadcast(std::uint32_t channel_id, std::uint64_t timestamp_ns,
   });
 }
 
-bool Server::has_subscribers(std::uint32_t channel_id) const noexcept {
+int Server::subscriber_count(std::uint32_t channel_id) const noexcept {
   const int i = impl_->channel_index(channel_id);
-  return i >= 0 && impl_->subscribers[i].load(std::memory_order_relaxed) > 0;
+  return i >= 0 ? static_cast<int>(impl_->subscribers[i].load(std::memory_order_relaxed)) : 0;
 }
 
 ServerCounters Server::counters() const noexcept {

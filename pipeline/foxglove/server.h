@@ -68,8 +68,11 @@ class Server {
   // channel (the payload is shared, not copied per client).
   void broadcast(std::uint32_t channel_id, std::uint64_t timestamp_ns,
                  std::shared_ptr<const std::string> payload);
-  // True when at least one client subscribes to the channel (any thread, relaxed).
-  bool has_subscribers(std::uint32_t channel_id) const noexcept;
+  // How many clients subscribe to the channel (any thread, relaxed); 0 for no channel.
+  int subscriber_count(std::uint32_t channel_id) const noexcept;
+  bool has_subscribers(std::uint32_t channel_id) const noexcept {
+    return subscriber_count(channel_id) > 0;
+  }
   ServerCounters counters() const noexcept;
 
   struct Impl;
