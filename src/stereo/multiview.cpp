@@ -24,6 +24,7 @@ MultiViewMerger::MultiViewMerger(const Rig& rig, const MultiViewConfig& config)
       config_(config),
       hyp_(static_cast<std::size_t>(config.max_hypotheses)),
       views_(static_cast<std::size_t>(config.max_hypotheses)),
+      extended_(static_cast<std::size_t>(config.max_hypotheses)),
       order_(static_cast<std::size_t>(config.max_hypotheses)),
       taken_by_(rig.cameras.size() * static_cast<std::size_t>(config.max_points_per_camera)) {}
 
@@ -125,7 +126,14 @@ bool MultiViewMerger::process(const Vec2* const* px, const int* n, const PointLi
   for (int i = 0; i < count; ++i) {
     Point3& h = hyp_[static_cast<std::size_t>(i)];
     extend(h, px, n);
-    refine(h, px);
+    extended_[static_cast<std::size_t>(i)] = h.blob_index;
+    int same = -1;  // the same point from another pair: the same blobs once extended
+    for (int k = 0; k < i && same < 0; ++k)
+      if (extended_[static_cast<std::size_t>(k)] == h.blob_index) same = k;
+    if (same >= 0)
+      h = hyp_[static_cast<std::size_t>(same)];  // refined already
+    else
+      refine(h, px);
     int v = 0;
     for (std::int16_t j : h.blob_index) v += j >= 0 ? 1 : 0;
     views_[static_cast<std::size_t>(i)] = v;

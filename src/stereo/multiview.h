@@ -22,6 +22,7 @@
 // and rejections are counters. Each output point records its blob per camera.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -76,9 +77,10 @@ class MultiViewMerger {
 
   std::vector<CameraModel> cams_;
   MultiViewConfig config_;
-  std::vector<Point3> hyp_;    // workspace: this frame's hypotheses
-  std::vector<int> views_;     // views per hypothesis
-  std::vector<int> order_;     // hypotheses in acceptance order
+  std::vector<Point3> hyp_;  // workspace: this frame's hypotheses
+  std::vector<int> views_;   // views per hypothesis
+  std::vector<std::array<std::int16_t, kMaxCameras>> extended_;  // blobs before refinement
+  std::vector<int> order_;                                       // hypotheses in acceptance order
   std::vector<int> taken_by_;  // [camera * max_points_per_camera + blob]: output index
   MultiViewCounters counters_;
 };

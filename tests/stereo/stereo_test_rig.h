@@ -1,9 +1,11 @@
 // Test fixtures shared by the stereo tests and benchmarks: the paper's rig (two
-// 1032x776 cameras, f ~ 1290 px, 477 mm baseline, verged toward a point 1 m ahead)
-// and helpers to place cameras by look-at.
+// 1032x776 cameras, f ~ 1290 px, 477 mm baseline, verged toward a point 1 m ahead), a
+// 4-camera ring, and helpers to place cameras by look-at.
 #pragma once
 
+#include <cmath>
 #include <random>
+#include <string>
 
 #include "camera/camera_model.h"
 
@@ -46,6 +48,25 @@ inline Rig paper_rig(double baseline_mm = 477.0) {
   rig.cameras[1].fy = 1289.9;
   rig.cameras[1].cx = 517.2;
   rig.cameras[1].cy = 385.9;
+  return rig;
+}
+
+// Four cameras on a 120-degree arc of radius 1.4 m around (0, 0, 1000) mm, at two
+// heights, each with its own focal length and distortion (a multi-camera rig).
+inline Rig ring_rig() {
+  Rig rig;
+  const Vec3 target(0.0, 0.0, 1000.0);
+  const double r = 1400.0;
+  const double f[4] = {1290.0, 1100.0, 1450.0, 1200.0};
+  const std::array<double, 5> d[4] = {{-0.12, 0.09, 0.0005, -0.0003, -0.01},
+                                      {-0.25, 0.12, 0.0, 0.0, -0.02},
+                                      {0.05, -0.02, 0.0, 0.0, 0.0},
+                                      {-0.18, 0.05, 0.0002, 0.0004, 0.0}};
+  for (int k = 0; k < 4; ++k) {
+    const double a = (-60.0 + 40.0 * k) * M_PI / 180.0;  // a 120 degree arc
+    const Vec3 C = target + Vec3(r * std::sin(a), -300.0 + 150.0 * (k % 2), -r * std::cos(a));
+    rig.cameras.push_back(look_at_camera("cam" + std::to_string(k), C, target, f[k], d[k]));
+  }
   return rig;
 }
 

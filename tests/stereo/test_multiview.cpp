@@ -22,23 +22,6 @@
 namespace mocap {
 namespace {
 
-Rig ring_rig() {
-  Rig rig;
-  const Vec3 target(0.0, 0.0, 1000.0);
-  const double r = 1400.0;
-  const double f[4] = {1290.0, 1100.0, 1450.0, 1200.0};
-  const std::array<double, 5> d[4] = {{-0.12, 0.09, 0.0005, -0.0003, -0.01},
-                                      {-0.25, 0.12, 0.0, 0.0, -0.02},
-                                      {0.05, -0.02, 0.0, 0.0, 0.0},
-                                      {-0.18, 0.05, 0.0002, 0.0004, 0.0}};
-  for (int k = 0; k < 4; ++k) {
-    const double a = (-60.0 + 40.0 * k) * M_PI / 180.0;  // a 120 degree arc
-    const Vec3 C = target + Vec3(r * std::sin(a), -300.0 + 150.0 * (k % 2), -r * std::cos(a));
-    rig.cameras.push_back(test::look_at_camera("cam" + std::to_string(k), C, target, f[k], d[k]));
-  }
-  return rig;
-}
-
 struct Frame {
   std::vector<Vec3> X;                  // true points
   std::vector<std::vector<Vec2>> px;    // per camera: blobs (shuffled)
@@ -155,7 +138,7 @@ struct Stage {
 };
 
 TEST(MultiView, FourCamerasFindEveryPointSeenThreeTimesWithoutGhosts) {
-  const Rig rig = ring_rig();
+  const Rig rig = test::ring_rig();
   Stage st(rig);
   std::mt19937 rng(11);
   int expected = 0, found = 0, ghosts = 0, spurious = 0;
@@ -222,7 +205,7 @@ TEST(MultiView, FourCamerasFindEveryPointSeenThreeTimesWithoutGhosts) {
 }
 
 TEST(MultiView, ProcessAllocatesNothing) {
-  const Rig rig = ring_rig();
+  const Rig rig = test::ring_rig();
   Stage st(rig);
   std::mt19937 rng(5);
   Frame f = make_frame(rig, rng, 20, 0);
