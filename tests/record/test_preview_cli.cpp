@@ -1,6 +1,7 @@
-// `mocap preview` end to end on the built-in simulated cameras: one PNG overlay per
-// camera, preview.json with the counts against the thresholds, a summary and a
-// recommendation line per camera; bad input is a one-line error.
+// `mocap preview` end to end on the built-in simulated cameras, configured as on the
+// first day (cameras only: no rig, no targets, no model): one PNG overlay per camera,
+// preview.json with the counts against the thresholds, a summary and a recommendation
+// line per camera; bad input is a one-line error.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -12,7 +13,12 @@ namespace {
 
 TEST(PreviewCli, SimCamerasGiveOverlaysAndASummary) {
   TempDir dir("preview");
-  const RunResult r = run_mocap("preview --out " + dir.file("p") + " --loop-frames 2", 120);
+  write_file(dir.file("cameras.yaml"),
+             "version: 1\ncameras:\n  - {backend: sim, trigger: software}\n"
+             "  - {backend: sim, trigger: external}\n");  // no targets exist yet
+  const RunResult r = run_mocap("preview --config " + dir.file("cameras.yaml") + " --out " +
+                                    dir.file("p") + " --loop-frames 2",
+                                120);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   for (const char* cam : {"cam0", "cam1"}) {
     const std::string png = read_file(dir.file(std::string("p/") + cam + ".png"));
