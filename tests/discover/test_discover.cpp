@@ -117,5 +117,24 @@ TEST(DiscoverErrors, TooFewFramesAndStaticScene) {
       << r.error().message;
 }
 
+// The whole robot turned rigidly (joints fixed): one body, no joint to find.
+TEST(DiscoverErrors, OneRigidBodyOnly) {
+  const std::vector<Vec3> markers = {Vec3(0, 0, 0), Vec3(60, 0, 0), Vec3(0, 45, 0),
+                                     Vec3(20, 30, 40), Vec3(-35, 10, 25)};
+  discover::PointSequence seq;
+  for (int f = 0; f < 120; ++f) {  // 1.2 s at 100 Hz, turning 90 deg about a tilted axis
+    const Iso3 T =
+        make_iso(Eigen::AngleAxisd(0.0131 * f, Vec3(0.3, 1.0, 0.2).normalized()).toRotationMatrix(),
+                 Vec3(100.0 + 0.5 * f, -50.0, 1000.0));
+    std::vector<Vec3> pts;
+    for (const Vec3& m : markers) pts.push_back(T * m);
+    seq.frames.push_back({f, f * 10000000LL, pts});
+  }
+  auto r = discover::discover_model(seq, discover::DiscoverOptions{}, "rec");
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().message.rfind("rec: one rigid body only (5 markers", 0), 0u)
+      << r.error().message;
+}
+
 }  // namespace
 }  // namespace mocap
