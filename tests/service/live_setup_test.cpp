@@ -99,12 +99,14 @@ TEST(LiveSetup, RegistryOutputsFromTheFileAndTheFlags) {
       << bad.error().message;
   EXPECT_EQ(check_config_command(dir.file("bad.yaml")), 1);
   // The map form: `value` plus options, checked against the output's option keys.
-  test::write_file(dir.file("map.yaml"), "outputs:\n  ros2: {a: 1}\n");
-  auto map = resolve_run_config(dir.file("map.yaml"), CliOverrides{});
-  ASSERT_FALSE(map);
-  EXPECT_EQ(map.error().message, dir.file("map.yaml") +
-                                     ": outputs.ros2: the map form needs a "
-                                     "'value' (line 2)");
+  // error_of(file, ros2's value): the one-line error of that configuration ("" if none).
+  const auto error_of = [&](const std::string& file, const std::string& ros2) {
+    test::write_file(dir.file(file), "outputs:\n  ros2: " + ros2 + "\n");
+    auto r = resolve_run_config(dir.file(file), CliOverrides{});
+    return r ? std::string() : r.error().message;
+  };
+  EXPECT_EQ(error_of("map.yaml", "{a: 1}"),
+            dir.file("map.yaml") + ": outputs.ros2: the map form needs a 'value' (line 2)");
   test::write_file(dir.file("opt.yaml"), "outputs:\n  ros2: {value: false, domain_id: 7}\n");
   auto opt = resolve_run_config(dir.file("opt.yaml"), CliOverrides{});
   ASSERT_TRUE(opt) << opt.error().message;
@@ -115,18 +117,11 @@ TEST(LiveSetup, RegistryOutputsFromTheFileAndTheFlags) {
   auto with_flag = resolve_run_config(dir.file("opt.yaml"), cli);  // --ros2 keeps domain_id
   ASSERT_TRUE(with_flag) << with_flag.error().message;
   EXPECT_EQ(output_requests(*with_flag, cli)[2].options, (Options{{"domain_id", "7"}}));
-  test::write_file(dir.file("typo.yaml"), "outputs:\n  ros2: {value: false, domain: 7}\n");
-  auto typo = resolve_run_config(dir.file("typo.yaml"), CliOverrides{});
-  ASSERT_FALSE(typo);
-  EXPECT_EQ(typo.error().message, dir.file("typo.yaml") +
-                                      ": outputs.ros2 (line 2): domain: "
-                                      "unknown option (known: domain_id)");
-  test::write_file(dir.file("deep.yaml"), "outputs:\n  ros2: {value: false, domain_id: [1]}\n");
-  auto deep = resolve_run_config(dir.file("deep.yaml"), CliOverrides{});
-  ASSERT_FALSE(deep);
-  EXPECT_NE(deep.error().message.find("outputs.ros2.domain_id: expected a value, got"),
-            std::string::npos)
-      << deep.error().message;
+  EXPECT_EQ(
+      error_of("typo.yaml", "{value: false, domain: 7}"),
+      dir.file("typo.yaml") + ": outputs.ros2 (line 2): domain: unknown option (known: domain_id)");
+  const std::string deep = error_of("deep.yaml", "{value: false, domain_id: [1]}");
+  EXPECT_NE(deep.find("outputs.ros2.domain_id: expected a value, got"), std::string::npos) << deep;
 }
 
 TEST(LiveSetup, ReplayCamerasConfiguredFromTheFile) {
