@@ -1,6 +1,7 @@
 // Design: `mocap simulate --out DIR [options]`: parses the flags with CLI11 and calls
 // mocap::sim::write_simulated_recording (the library entry point); --scene picks the
-// marker layout, --rig renders through a user-given rig. Errors are one line
+// marker layout, --cameras N renders through the built-in 2..8 cameras, --rig through a
+// user-given rig of 2..8 cameras. Errors are one line
 // on stderr with exit code 2; success prints a one-line summary on stdout.
 #include <cstdio>
 #include <string>
@@ -21,17 +22,27 @@ void register_simulate(CLI::App& app, int& exit_code) {
     sim::SimOptions opt;
     std::uint64_t seed = 1;
     bool noise_given = false;
+    bool cameras_given = false;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
-      "simulate", "Write a synthetic stereo recording of the shoulder test rig with ground truth");
+      "simulate",
+      "Write a synthetic recording (2..8 cameras) of the shoulder test rig with ground truth");
   cmd->add_option("--out", args->out, "Output folder (created if needed)")->required();
   cmd->add_option("--frames", args->opt.frames, "Number of frames (default 100)");
   cmd->add_option("--scene", args->scene,
                   "Marker layout: limbs (markers all around the limbs) | stalks (stress "
                   "variant) (default limbs)");
   cmd->add_option("--rig", args->opt.rig_path,
-                  "Render through this rig.yaml (2 cameras) instead of the built-in pair");
+                  "Render through this rig.yaml (2..8 cameras) instead of the built-in cameras");
+  cmd->add_option_function<int>(
+      "--cameras",
+      [args](const int& n) {
+        args->opt.cameras = n;
+        args->cameras_given = true;
+      },
+      "Built-in cameras, 2..8: 2 = the stereo pair, 3..8 on an arc around the "
+      "robot (default 2; with --rig: the rig's count)");
   cmd->add_option("--motion", args->motion,
                   "smooth | poses | move400 | viewpoints | wand | lframe (default smooth)");
   cmd->add_option("--seed", args->seed, "Random seed of noise, drop-outs and strays (default 1)");
@@ -62,6 +73,10 @@ void register_simulate(CLI::App& app, int& exit_code) {
       return;
     }
     args->opt.scene = *scene;
+    if (args->cameras_given && (args->opt.cameras < 2 || args->opt.cameras > 8)) {
+      exit_code = fail("simulate: cameras: must be 2..8, got " + std::to_string(args->opt.cameras));
+      return;
+    }
     if (args->motion == "wand" || args->motion == "lframe") {  // rig calibration recordings
       args->opt.seed = args->seed;
       ProgressBar bar("simulate", args->opt.frames);

@@ -11,38 +11,12 @@
 
 #include "core/rotation.h"
 #include "core/units.h"
+#include "sim/scene_cameras.h"
 #include "sim/scene_rig.h"
 #include "sim/sim_rng.h"
 
 namespace mocap::sim {
 namespace {
-
-CameraModel make_camera(const std::string& name, double x_mm, const CameraMount& mount, double fx,
-                        double fy, double cx, double cy, const std::array<double, 5>& dist,
-                        double roll_deg) {
-  CameraModel cam;
-  cam.name = name;
-  cam.width = 1032;
-  cam.height = 776;
-  cam.fx = fx;
-  cam.fy = fy;
-  cam.cx = cx;
-  cam.cy = cy;
-  cam.distortion = dist;
-  const Vec3 center(mount.x_mm + x_mm, mount.y_mm, mount.z_mm);
-  const Vec3 aim(mount.x_mm, 250.0, mount.aim_z_mm);  // where the optical axes cross
-  const Vec3 z = (aim - center).normalized();
-  const Vec3 x = z.cross(Vec3::UnitZ()).normalized();
-  const Vec3 y = z.cross(x);
-  Mat3 R;
-  R.row(0) = x.transpose();
-  R.row(1) = y.transpose();
-  R.row(2) = z.transpose();
-  R = rot_z(roll_deg * kRadPerDeg) * R;  // a small mounting roll about the optical axis
-  cam.R_cam_world = R;
-  cam.t_cam_world = -R * center;
-  return cam;
-}
 
 struct Limb {
   Vec3 a_world, b_world;
@@ -90,11 +64,12 @@ Expected<SimScene> build_shoulder_scene(const SceneOptions& options) {
   scene.imaging = im;
   scene.marker_radius_mm = 6.0;
   scene.kind = options.kind;
-  const CameraMount mount = camera_mount(options.kind);
-  scene.rig.cameras.push_back(make_camera("cam0", -238.5, mount, 1291.2, 1290.6, 517.3, 385.9,
-                                          {-0.121, 0.083, 0.0004, -0.0003, 0.0}, 0.3));
-  scene.rig.cameras.push_back(make_camera("cam1", 238.5, mount, 1288.7, 1288.1, 513.8, 389.4,
-                                          {-0.118, 0.079, -0.0002, 0.0005, 0.0}, -0.4));
+  if (!options.rig && (options.cameras < kMinSimCameras || options.cameras > kMaxSimCameras)) {
+    return make_error("simulate", "cameras",
+                      "must be " + std::to_string(kMinSimCameras) + ".." +
+                          std::to_string(kMaxSimCameras) + ", got " +
+                          std::to_string(options.cameras));
+  }
 
   // Body frames at the reference configuration (deliberately rotated).
   scene.T_world_body_ref = {
@@ -181,10 +156,17 @@ Expected<SimScene> build_shoulder_scene(const SceneOptions& options) {
                            std::vector<double>{q0.w(), q0.x(), q0.y(), q0.z()});
   scene.joints_true.joints = {shoulder, elbow};
 
-  if (options.rig) {  // a user-given rig replaces the built-in pair
+  if (options.rig) {  // a user-given rig replaces the built-in cameras
     const std::string source = options.rig_source.empty() ? "rig" : options.rig_source;
     if (auto r = check_rig_for_scene(*options.rig, scene, source); !r) return r.error();
     scene.rig = *options.rig;
+  } else {
+    scene.rig.cameras = built_in_cameras(options.kind, scene.robot_center_world, options.cameras);
+    if (options.cameras > 2) {  // the ring goes through the user rig's scene check
+      const std::string source =
+          "simulate: built-in " + std::to_string(options.cameras) + "-camera rig";
+      if (auto r = check_rig_for_scene(scene.rig, scene, source); !r) return r.error();
+    }
   }
 
   // Shiny spots (glints) on the limbs, placed from the seed.

@@ -2,7 +2,8 @@
 // rigid bodies (torso, upper_arm, lower_arm), each a set of capsules (limbs and the
 // posts that hold the 12 mm marker balls) carrying a marker target, a ball joint
 // (shoulder: torso -> upper_arm) and a hinge (elbow: upper_arm -> lower_arm), seen by a
-// verged stereo pair like the paper's, or by a user-given rig (scene_rig.h). Two marker
+// verged stereo pair like the paper's, by 3..8 built-in cameras on an arc around the
+// robot (scene_cameras.h), or by a user-given rig of 2..8 cameras (scene_rig.h). Two marker
 // layouts (scene_layouts.h): `limbs` (default, markers all around each limb on short
 // bases) and `stalks` (the stress variant). SimScene is immutable after
 // build_shoulder_scene(); a SceneState (body poses + noise key) is what changes per
@@ -77,7 +78,8 @@ ImagingParams default_imaging(int bits, int maxval);
 
 struct SceneOptions {
   SceneKind kind = SceneKind::kLimbs;  // marker layout
-  std::optional<Rig> rig;              // user-given cameras (checked); none: the built-in pair
+  std::optional<Rig> rig;              // user-given cameras (checked); none: the built-in ones
+  int cameras = 2;                     // built-in cameras (2..8; ignored with a rig)
   std::string rig_source;              // names the user rig in errors (its file)
   std::uint64_t seed = 1;
   int stray_glints = 0;  // number of shiny spots on the limbs

@@ -8,6 +8,7 @@
 #include <cstdio>
 
 #include "sim/scene.h"
+#include "sim/scene_cameras.h"
 
 namespace mocap::sim {
 namespace {
@@ -59,11 +60,24 @@ Expected<void> check_lens(const CameraModel& cam, const std::string& source,
 
 Expected<void> check_rig_for_scene(const Rig& rig, const SimScene& scene,
                                    const std::string& source) {
-  if (rig.cameras.size() != 2) {
+  const auto n = static_cast<int>(rig.cameras.size());
+  if (n < kMinSimCameras || n > kMaxSimCameras) {
     return make_error(source, "cameras",
-                      "the simulator renders a stereo pair: exactly 2 cameras are needed, the "
-                      "rig has " +
-                          std::to_string(rig.cameras.size()));
+                      "the simulator renders " + std::to_string(kMinSimCameras) + " to " +
+                          std::to_string(kMaxSimCameras) + " cameras, the rig has " +
+                          std::to_string(n));
+  }
+  for (std::size_t c = 0; c < rig.cameras.size(); ++c) {  // names are the frame folders
+    for (std::size_t d = 0; d < c; ++d) {
+      if (rig.cameras[c].name == rig.cameras[d].name)
+        return make_error(source, "camera '" + rig.cameras[c].name + "'",
+                          "listed twice (the name is its recording folder)");
+    }
+    if (rig.cameras[c].name.empty() || rig.cameras[c].name == "gt" ||
+        rig.cameras[c].name.find('/') != std::string::npos)
+      return make_error(source, "camera " + std::to_string(c),
+                        "name '" + rig.cameras[c].name +
+                            "' cannot be a recording folder (empty, 'gt' or with '/')");
   }
   for (std::size_t c = 0; c < rig.cameras.size(); ++c) {
     const CameraModel& cam = rig.cameras[c];

@@ -3,9 +3,10 @@
 // principal points, wide angle) and other camera placements than the ones the tracker
 // was written against. The rig replaces the scene's cameras; the robot, its markers and
 // the image physics stay the same. Before anything is rendered, the rig is checked
-// against the scene, each problem one line naming the rig file and the camera:
-//  - exactly 2 cameras (the stereo pair; the renderer and the recording are written for
-//    a camera list, the count is fixed at 2 until the tracker takes 2-8 cameras);
+// against the scene, each problem one line naming the rig file and the camera (the
+// built-in cameras for --cameras 3..8 go through the same check):
+//  - 2 to 8 cameras (the spec's extension of 2026-12), with distinct names that can be
+//    recording folders (not empty, not 'gt', no '/');
 //  - a physical lens over the whole image: every image corner undistorts, and the
 //    radial mapping r -> r * (1 + k1 r^2 + k2 r^4 + k3 r^6) keeps increasing out to the
 //    farthest corner (a lens whose model folds over inside the image would map two

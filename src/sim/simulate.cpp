@@ -1,14 +1,15 @@
 // Design: the recording writer. Per frame: forward kinematics, one render per camera
-// (StereoRender, frame_writer.h: camera 1 on a second thread with its own workspace
-// when threads = 2; results are identical either way because every random draw is
-// keyed by seed, frame and camera), the PGM files, then the ground-truth rows. Files
-// are written with mocap_formats.
+// (MultiRender, frame_writer.h: 2..8 cameras, the odd ones on a second thread with its
+// own workspace when threads = 2; results are identical either way because every
+// random draw is keyed by seed, frame and camera), the PGM files, then the
+// ground-truth rows (per-camera columns for every camera). Files are written with
+// mocap_formats.
 #include "sim/simulate.h"
 
-#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <vector>
 
 #include "core/rotation.h"
 #include "core/units.h"
@@ -73,9 +74,15 @@ Expected<SimScene> make_scene(const SimOptions& o) {
     return make_error("simulate", "maxval", "must be 256..65535 for 16-bit output");
   SceneOptions so;
   so.kind = o.scene;
+  so.cameras = o.cameras == 0 ? 2 : o.cameras;
   if (!o.rig_path.empty()) {
     auto rig = load_rig(o.rig_path);
     if (!rig) return rig.error();
+    if (o.cameras != 0 && static_cast<std::size_t>(o.cameras) != rig->cameras.size()) {
+      return make_error("simulate", "cameras",
+                        std::to_string(o.cameras) + " requested but the rig " + o.rig_path +
+                            " has " + std::to_string(rig->cameras.size()));
+    }
     so.rig = std::move(rig).value();
     so.rig_source = o.rig_path;
   }
@@ -115,9 +122,10 @@ Expected<SimSummary> write_simulated_recording(const SimOptions& options, const 
   if (!poses_csv) return poses_csv.error();
   auto angles_csv = open_angles_csv(dir + "/gt/angles.csv");
   if (!angles_csv) return angles_csv.error();
-  auto markers_csv = CsvFile::open(dir + "/gt/markers.csv",
-                                   "frame,body,marker,x,y,z,u0,v0,vis0,u1,v1,vis1,"
-                                   "frac0,merged0,dropped0,frac1,merged1,dropped1");
+  const int n_cams = static_cast<int>(scene.rig.cameras.size());
+  auto markers_csv = CsvFile::open(
+      dir + "/gt/markers.csv",
+      ("frame,body,marker,x,y,z," + markers_csv_camera_columns(n_cams, true)).c_str());
   if (!markers_csv) return markers_csv.error();
   auto strays_csv = CsvFile::open(dir + "/gt/strays.csv", "frame,camera,kind,x,y,z,u,v,peak_dn");
   if (!strays_csv) return strays_csv.error();
@@ -131,20 +139,20 @@ Expected<SimSummary> write_simulated_recording(const SimOptions& options, const 
                  s.robot_translation_mm.y(), s.robot_translation_mm.z());
   }
 
-  auto stereo = StereoRender::create(scene, options.threads);
-  if (!stereo) return stereo.error();
-  std::array<Image, 2> images = {make_camera_image(scene, 0), make_camera_image(scene, 1)};
-  const std::array<const RenderWorkspace*, 2> results = {&stereo->workspace(0),
-                                                         &stereo->workspace(1)};
+  auto renderer = MultiRender::create(scene, options.threads);
+  if (!renderer) return renderer.error();
+  std::vector<Image> images = make_camera_images(scene);
+  std::vector<const CameraViews*> results;
+  for (int c = 0; c < n_cams; ++c) results.push_back(&renderer->views(c));
   SceneState state = make_state(scene);
   SimSummary summary;
   summary.frames = options.frames;
-  summary.cameras = 2;
+  summary.cameras = n_cams;
 
   for (int f = 0; f < options.frames; ++f) {
     apply_config(scene, plan.configs[static_cast<std::size_t>(f)], state);
     state.noise_key = frame_noise_key(options.seed, f);
-    auto rendered = stereo->render(state, {&images[0], &images[1]}, [&](int c) {
+    auto rendered = renderer->render(state, images, [&](int c) {
       const auto uc = static_cast<std::size_t>(c);
       return write_pgm(frame_file_path(dir, scene.rig.cameras[uc].name, f), images[uc].view());
     });
@@ -184,9 +192,9 @@ Expected<SimSummary> write_simulated_recording(const SimOptions& options, const 
           markers_csv->handle(), "%d,%s,%d,%.6f,%.6f,%.6f", f,
           scene.targets.bodies[static_cast<std::size_t>(scene.marker_body[um])].name.c_str(),
           scene.marker_index[um], X.x(), X.y(), X.z());
-      for (const RenderWorkspace* r : results)
+      for (const CameraViews* r : results)
         write_marker_view(markers_csv->handle(), r->markers[um], summary);
-      for (const RenderWorkspace* r : results) {
+      for (const CameraViews* r : results) {
         const MarkerView& mv = r->markers[um];
         const double total = mv.visible_area_px + mv.occluded_area_px;
         const double frac = (total > 0.0 && mv.inside_image) ? mv.visible_area_px / total : 0.0;
@@ -195,8 +203,8 @@ Expected<SimSummary> write_simulated_recording(const SimOptions& options, const 
       }
       std::fputc('\n', markers_csv->handle());
     }
-    for (int c = 0; c < 2; ++c) {
-      const RenderWorkspace& r = *results[static_cast<std::size_t>(c)];
+    for (int c = 0; c < n_cams; ++c) {
+      const CameraViews& r = *results[static_cast<std::size_t>(c)];
       for (int k = 0; k < r.stray_count; ++k) {
         const StrayView& s = r.strays[static_cast<std::size_t>(k)];
         std::fprintf(strays_csv->handle(), "%d,%d,%s,%.4f,%.4f,%.4f,%.4f,%.4f,%.2f\n", f, c,

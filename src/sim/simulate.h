@@ -1,6 +1,6 @@
 // Design: the library entry point of `mocap simulate`: builds the shoulder scene from
-// SimOptions, plans the motion, renders every frame of both cameras and writes the
-// recording folder (spec: rig.yaml, frames.csv, cam0/, cam1/), targets.yaml,
+// SimOptions, plans the motion, renders every frame of every camera (2..8) and writes
+// the recording folder (spec: rig.yaml, frames.csv, cam0/, cam1/, ...), targets.yaml,
 // joints.yaml and the ground truth under gt/ (poses.csv, angles.csv, markers.csv,
 // strays.csv, segments.csv, model_true.yaml); see docs/simulator.md for every file
 // and column. Setup-style code: errors are one line, "simulate: key: problem" or
@@ -19,7 +19,8 @@ namespace mocap::sim {
 
 struct SimOptions {
   SceneKind scene = SceneKind::kLimbs;  // marker layout (scene_layouts.h)
-  std::string rig_path;                 // user rig (rig.yaml) instead of the built-in pair
+  std::string rig_path;                 // user rig (rig.yaml, 2..8 cameras) instead of the built-in
+  int cameras = 0;  // built-in cameras 2..8 (0: 2, the pair); with rig_path: 0 or its count
   int frames = 100;
   MotionKind motion = MotionKind::kSmooth;
   std::uint64_t seed = 1;

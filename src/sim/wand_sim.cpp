@@ -2,7 +2,8 @@
 // wand_sim.h). The scene reuses the shoulder scenario's rig and imaging (make_scene)
 // so the calibration recordings are seen by exactly the rig the other recordings use.
 // Bodies: 0 = the calibration object, 1 = the room (static glints only).
-// The folder set-up and the two-camera render + PGM writing are frame_writer.h's.
+// The folder set-up and the render of every camera (2..8) + PGM writing are
+// frame_writer.h's.
 #include "sim/wand_sim.h"
 
 #include <array>
@@ -10,6 +11,7 @@
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <vector>
 
 #include "core/rotation.h"
 #include "core/units.h"
@@ -177,23 +179,26 @@ Expected<SimSummary> write_calibration_recording(const SimOptions& options, Cali
         !r)
       return r.error();
   }
+  const int n_cams = static_cast<int>(rig.cameras.size());
   auto markers_csv =
-      CsvFile::open(dir + "/gt/markers.csv", "frame,marker,x,y,z,u0,v0,vis0,u1,v1,vis1");
+      CsvFile::open(dir + "/gt/markers.csv",
+                    ("frame,marker,x,y,z," + markers_csv_camera_columns(n_cams, false)).c_str());
   if (!markers_csv) return markers_csv.error();
 
-  auto stereo = StereoRender::create(scene, options.threads);
-  if (!stereo) return stereo.error();
-  const std::array<const RenderWorkspace*, 2> ws = {&stereo->workspace(0), &stereo->workspace(1)};
-  std::array<Image, 2> images = {make_camera_image(scene, 0), make_camera_image(scene, 1)};
+  auto renderer = MultiRender::create(scene, options.threads);
+  if (!renderer) return renderer.error();
+  std::vector<const CameraViews*> ws;
+  for (int c = 0; c < n_cams; ++c) ws.push_back(&renderer->views(c));
+  std::vector<Image> images = make_camera_images(scene);
   SceneState state = make_state(scene);
   SimSummary summary;
   summary.frames = options.frames;
-  summary.cameras = 2;
+  summary.cameras = n_cams;
   for (int f = 0; f < options.frames; ++f) {
     if (kind == CalibObjectKind::kWand)
       state.T_world_body[0] = wand_pose(f, options.frames, options.seed);
     state.noise_key = frame_noise_key(options.seed, f);
-    auto rendered = stereo->render(state, {&images[0], &images[1]}, [&](int c) {
+    auto rendered = renderer->render(state, images, [&](int c) {
       const auto uc = static_cast<std::size_t>(c);
       return write_pgm(frame_file_path(dir, rig.cameras[uc].name, f), images[uc].view());
     });
@@ -202,11 +207,11 @@ Expected<SimSummary> write_calibration_recording(const SimOptions& options, Cali
       const auto um = static_cast<std::size_t>(m);
       const Vec3 X = state.T_world_body[0] * scene.marker_in_body(m);
       std::fprintf(markers_csv->handle(), "%d,%d,%.6f,%.6f,%.6f", f, m, X.x(), X.y(), X.z());
-      for (const RenderWorkspace* w : ws)
+      for (const CameraViews* w : ws)
         write_marker_view(markers_csv->handle(), w->markers[um], summary);
       std::fputc('\n', markers_csv->handle());
     }
-    for (const RenderWorkspace* w : ws) {
+    for (const CameraViews* w : ws) {
       for (int s = 0; s < w->stray_count; ++s) {
         summary.stray_blobs +=
             w->strays[static_cast<std::size_t>(s)].kind == StrayKind::kGlint ? 1 : 0;

@@ -1,6 +1,7 @@
 // Design: wand and L-frame recordings for rig calibration (`mocap simulate --motion wand`
 // / `--motion lframe`, docs/rig_calibration.md). They reuse the shoulder scenario's
-// stereo rig, imaging model and renderer, with a different scene:
+// rig (the built-in pair, --cameras N or --rig), imaging model and renderer, with a
+// different scene:
 //  - wand:   one rigid body, a straight rod carrying 3..8 marker balls at the offsets of
 //            the wand description plus a handle (both dark, they occlude), waved through
 //            the cameras' common volume on a smooth quasi-random path (sums of
@@ -12,7 +13,8 @@
 // Both scenes add static shiny spots in the room (glints, --stray) and the renderer's
 // random drop-outs (--dropout). Ground truth: gt/rig_true.yaml (the true rig),
 // gt/rig_lframe_true.yaml (the true rig with the L-frame as world, lframe only),
-// gt/markers.csv (frame,marker,x,y,z,u0,v0,vis0,u1,v1,vis1), plus wand.yaml.
+// gt/markers.csv (frame,marker,x,y,z, then uK,vK,visK for every camera K: for two
+// cameras u0,v0,vis0,u1,v1,vis1), plus wand.yaml.
 #pragma once
 
 #include <functional>
