@@ -2,8 +2,9 @@
 // built-in pair is exactly the pair it always was; every camera of the built-in 3..8
 // camera arcs passes the scene-in-view check and the 4 cameras look from clearly
 // different directions, so that limbs hide markers from some cameras and not others;
-// a 3-camera user rig renders into 3 folders with per-camera ground-truth columns; 1 and
-// 9 cameras are one-line errors. Lean: at most a few frames are rendered.
+// a 3-camera user rig renders into 3 folders with per-camera ground-truth columns; a
+// 4-camera wand recording has 4 cameras in gt/rig_true.yaml; 1 and 9 cameras are
+// one-line errors. Lean: at most a few frames are rendered.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -20,6 +21,7 @@
 #include "sim/scene_cameras.h"
 #include "sim/scene_rig.h"
 #include "sim/simulate.h"
+#include "sim/wand_sim.h"
 #include "tests/support/test_support.h"
 
 namespace mocap::sim {
@@ -228,6 +230,24 @@ TEST(SimCameras, ThreeCameraUserRigRenders) {
   ASSERT_FALSE(bad.ok());
   EXPECT_EQ(bad.error().message.rfind("simulate: cameras: 2 requested but the rig ", 0), 0u)
       << bad.error().message;
+}
+
+TEST(SimCameras, FourCameraWandRecording) {
+  test::TempDir dir("sim_wand4");
+  SimOptions opt;
+  opt.cameras = 4;
+  opt.frames = 2;
+  auto sum = write_calibration_recording(opt, CalibObjectKind::kWand, dir.path());
+  ASSERT_TRUE(sum.ok()) << sum.error().message;
+  EXPECT_EQ(sum->cameras, 4);
+  auto truth = load_rig(dir.file("gt/rig_true.yaml"));
+  ASSERT_TRUE(truth.ok()) << truth.error().message;
+  ASSERT_EQ(truth->cameras.size(), 4u);
+  EXPECT_EQ(truth->cameras[3].name, "cam3");
+  EXPECT_TRUE(fs::exists(dir.file("cam3/000001.pgm")));
+  const std::string gt = test::read_file(dir.file("gt/markers.csv"));
+  EXPECT_EQ(gt.substr(0, gt.find('\n')),
+            "frame,marker,x,y,z,u0,v0,vis0,u1,v1,vis1,u2,v2,vis2,u3,v3,vis3");
 }
 
 TEST(SimCameras, OneAndNineCamerasAreOneLineErrors) {
