@@ -63,9 +63,7 @@ void make_frame_result(std::uint64_t sequence, std::int64_t capture_ns, const Ta
     r.X_world_mm = {static_cast<float>(p.X_world.x()), static_cast<float>(p.X_world.y()),
                     static_cast<float>(p.X_world.z())};
     r.reproj_px = static_cast<float>(p.reproj_px);
-    int cameras = 0;
-    for (std::int16_t b : p.blob_index) cameras += b >= 0 ? 1 : 0;
-    r.cameras = static_cast<std::uint8_t>(cameras);
+    r.cameras = static_cast<std::uint8_t>(p.blob_index.count());
   }
   result.point_count = points;
   int markers = 0;

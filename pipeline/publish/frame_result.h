@@ -14,13 +14,14 @@
 #include <type_traits>
 
 #include "client/joints_message.h"
+#include "core/camera_set.h"
 
 namespace mocap::publish {
 
 inline constexpr int kMaxResultBodies = 16;    // = identify's kMaxBodies
 inline constexpr int kMaxResultMarkers = 256;  // labelled markers per frame
 inline constexpr int kMaxResultPoints = 256;   // 3D points per frame (= kMaxPoints)
-inline constexpr int kMaxResultCameras = 4;    // cameras with blobs (= stereo's kMaxCameras)
+inline constexpr int kMaxResultCameras = kMaxCameras;  // cameras with blobs
 inline constexpr int kMaxResultBlobs = 64;     // blobs per camera
 
 struct ResultBody {
@@ -79,7 +80,7 @@ struct FrameResult {
   std::array<ResultBody, kMaxResultBodies> bodies{};
   std::array<ResultMarker, kMaxResultMarkers> markers{};
   std::array<ResultPoint, kMaxResultPoints> points{};
-  std::int32_t camera_count = 0;  // stereo cameras, rig order
+  std::int32_t camera_count = 0;  // the rig's cameras, in rig order
   std::array<CameraBlobs, kMaxResultCameras> cameras{};
 };
 

@@ -17,6 +17,7 @@ using namespace formats_detail;
 namespace {
 
 constexpr const char* kPointsHeader = "frame,x,y,z,reproj_px";
+constexpr const char* kPointsHeaderCameras = "frame,x,y,z,reproj_px,cameras";
 constexpr const char* kPosesHeader = "frame,timestamp_ns,body,qw,qx,qy,qz,tx,ty,tz,markers,rms_mm";
 constexpr const char* kAnglesHeader = "frame,timestamp_ns,joint,type,a0,a1,a2,qw,qx,qy,qz";
 // The header written: the spec's columns plus the 2026-12 extension columns at the end.
@@ -58,8 +59,8 @@ Expected<void> CsvFile::close() {
   return {};
 }
 
-Expected<CsvFile> open_points_csv(const std::string& path) {
-  return CsvFile::open(path, kPointsHeader);
+Expected<CsvFile> open_points_csv(const std::string& path, bool with_cameras) {
+  return CsvFile::open(path, with_cameras ? kPointsHeaderCameras : kPointsHeader);
 }
 Expected<CsvFile> open_poses_csv(const std::string& path) {
   return CsvFile::open(path, kPosesHeader);
@@ -70,8 +71,12 @@ Expected<CsvFile> open_angles_csv(const std::string& path) {
 
 void write_row(CsvFile& f, const PointRow& r) noexcept {
   if (!f.handle()) return;
-  std::fprintf(f.handle(), "%lld,%.6f,%.6f,%.6f,%.6f\n", static_cast<long long>(r.frame),
+  std::fprintf(f.handle(), "%lld,%.6f,%.6f,%.6f,%.6f", static_cast<long long>(r.frame),
                r.X_world.x(), r.X_world.y(), r.X_world.z(), r.reproj_px);
+  if (r.cameras > 0)
+    std::fprintf(f.handle(), ",%d\n", r.cameras);
+  else
+    std::fputc('\n', f.handle());
 }
 
 void write_row(CsvFile& f, const PoseRow& r) noexcept {
@@ -105,6 +110,7 @@ Expected<std::vector<PointRow>> read_points_csv(const std::string& path) {
       p.frame = r.integer(0);
       p.X_world = Vec3(r.number(1), r.number(2), r.number(3));
       p.reproj_px = r.number(4);
+      if (r.has_column(5)) p.cameras = static_cast<int>(r.integer(5));
       rows.push_back(p);
     }
     return rows;

@@ -20,6 +20,8 @@ struct PointRow {
   std::int64_t frame = 0;
   Vec3 X_world = Vec3::Zero();
   double reproj_px = 0.0;
+  // Cameras that saw the point (the extension column `cameras`); 0: not written/read.
+  int cameras = 0;
 };
 
 struct PoseRow {
@@ -69,7 +71,9 @@ class CsvFile {
   std::string path_;
 };
 
-Expected<CsvFile> open_points_csv(const std::string& path);
+// with_cameras: the header ends with the extension column `cameras` (rigs of more than
+// two cameras); rows then carry PointRow::cameras.
+Expected<CsvFile> open_points_csv(const std::string& path, bool with_cameras = false);
 Expected<CsvFile> open_poses_csv(const std::string& path);
 Expected<CsvFile> open_angles_csv(const std::string& path);
 void write_row(CsvFile& f, const PointRow& r) noexcept;

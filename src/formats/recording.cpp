@@ -107,4 +107,27 @@ Expected<FrameLoad> Recording::load_frame(int camera_index, std::int64_t frame, 
   return missing ? FrameLoad::kMissing : FrameLoad::kOk;
 }
 
+FrameSetLoader::FrameSetLoader(const Recording& rec)
+    : rec_(&rec),
+      images_(rec.rig().cameras.size()),
+      views_(rec.rig().cameras.size()),
+      present_(rec.rig().cameras.size(), nullptr) {}
+
+FrameSetLoader::Result FrameSetLoader::load(std::int64_t frame) {
+  Result r;
+  for (std::size_t c = 0; c < images_.size(); ++c) {
+    present_[c] = nullptr;
+    auto loaded = rec_->load_frame(static_cast<int>(c), frame, images_[c]);
+    if (!loaded) {
+      if (r.damaged++ == 0) r.problem = loaded.error().message;
+    } else if (*loaded == FrameLoad::kMissing) {
+      ++r.missing;
+    } else {
+      views_[c] = images_[c].view();
+      present_[c] = &views_[c];
+    }
+  }
+  return r;
+}
+
 }  // namespace mocap

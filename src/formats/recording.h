@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -26,6 +27,29 @@ Expected<void> save_frames_csv(const std::string& path, const std::vector<FrameE
 std::string frame_file_path(const std::string& dir, const std::string& camera, std::int64_t frame);
 
 enum class FrameLoad { kOk, kMissing };
+
+class Recording;
+
+// One frame of every camera of a recording, loaded into reused images: views() has one
+// entry per camera, null where that camera's frame is missing or damaged. Allocates on
+// the first frame (and when a frame's size or format changes), not after.
+class FrameSetLoader {
+ public:
+  struct Result {
+    int missing = 0;  // cameras whose file does not exist (a dropped frame)
+    int damaged = 0;  // cameras whose file exists but is malformed (see `problem`)
+    std::string problem;  // the first damaged file's one-line error, empty if none
+  };
+  explicit FrameSetLoader(const Recording& rec);
+  Result load(std::int64_t frame);
+  std::span<const ImageView* const> views() const noexcept { return present_; }
+
+ private:
+  const Recording* rec_;
+  std::vector<Image> images_;
+  std::vector<ImageView> views_;
+  std::vector<const ImageView*> present_;
+};
 
 class Recording {
  public:

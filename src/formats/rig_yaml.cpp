@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <set>
 
+#include "core/camera_set.h"
 #include "formats/pgm.h"
 #include "formats/text_io.h"
 #include "formats/yaml_read.h"
@@ -99,6 +100,9 @@ Expected<Rig> load_rig(const std::string& path) {
     require_list(cams, "cameras");
     if (cams.size() == 0)
       fail("cameras", "empty list (at least one camera is needed)" + line_suffix(cams));
+    if (cams.size() > static_cast<std::size_t>(kMaxCameras))
+      fail("cameras", std::to_string(cams.size()) + " cameras, at most " +
+                          std::to_string(kMaxCameras) + " are supported" + line_suffix(cams));
     Rig rig;
     std::set<std::string> names;
     for (std::size_t i = 0; i < cams.size(); ++i) {

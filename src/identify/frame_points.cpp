@@ -16,8 +16,7 @@ FramePoints::FramePoints(int max_points)
       partial_(static_cast<std::size_t>(max_points), 0),
       point_uses_(static_cast<std::size_t>(max_points), 0),
       pairs_(static_cast<std::size_t>(max_points) * static_cast<std::size_t>(max_points - 1) / 2) {
-  blob_uses_[0].assign(kBlobSlots, 0);
-  blob_uses_[1].assign(kBlobSlots, 0);
+  for (auto& uses : blob_uses_) uses.assign(kBlobSlots, 0);
 }
 
 FramePoints::LoadStats FramePoints::load(const MeasuredPoint* pts, int n,
@@ -58,17 +57,15 @@ FramePoints::LoadStats FramePoints::load(const MeasuredPoint* pts, int n,
 }
 
 bool FramePoints::exclusive(int i, int j) const noexcept {
-  const auto& a = blob_[static_cast<std::size_t>(i)];
-  const auto& b = blob_[static_cast<std::size_t>(j)];
-  return (a[0] >= 0 && a[0] == b[0]) || (a[1] >= 0 && a[1] == b[1]);
+  return blob_[static_cast<std::size_t>(i)].shares_blob(blob_[static_cast<std::size_t>(j)]);
 }
 
 bool FramePoints::available(int i) const noexcept {
   const auto s = static_cast<std::size_t>(i);
   if (!valid_[s] || point_uses_[s] != 0) return false;
-  for (int c = 0; c < 2; ++c) {
-    const std::int16_t b = blob_[s][static_cast<std::size_t>(c)];
-    if (b >= 0 && blob_uses_[c][static_cast<std::size_t>(b)] != 0) return false;
+  for (int c = 0; c < kMaxCameras; ++c) {
+    const std::int16_t b = blob_[s][c];
+    if (b >= 0 && blob_uses_[static_cast<std::size_t>(c)][static_cast<std::size_t>(b)] != 0) return false;
   }
   return true;
 }
@@ -76,9 +73,9 @@ bool FramePoints::available(int i) const noexcept {
 void FramePoints::acquire(int i) noexcept {
   const auto s = static_cast<std::size_t>(i);
   ++point_uses_[s];
-  for (int c = 0; c < 2; ++c) {
-    const std::int16_t b = blob_[s][static_cast<std::size_t>(c)];
-    if (b >= 0) ++blob_uses_[c][static_cast<std::size_t>(b)];
+  for (int c = 0; c < kMaxCameras; ++c) {
+    const std::int16_t b = blob_[s][c];
+    if (b >= 0) ++blob_uses_[static_cast<std::size_t>(c)][static_cast<std::size_t>(b)];
   }
 }
 
@@ -86,10 +83,10 @@ void FramePoints::release(int i) noexcept {
   const auto s = static_cast<std::size_t>(i);
   if (point_uses_[s] == 0) return;
   --point_uses_[s];
-  for (int c = 0; c < 2; ++c) {
-    const std::int16_t b = blob_[s][static_cast<std::size_t>(c)];
-    if (b >= 0 && blob_uses_[c][static_cast<std::size_t>(b)] > 0)
-      --blob_uses_[c][static_cast<std::size_t>(b)];
+  for (int c = 0; c < kMaxCameras; ++c) {
+    const std::int16_t b = blob_[s][c];
+    if (b >= 0 && blob_uses_[static_cast<std::size_t>(c)][static_cast<std::size_t>(b)] > 0)
+      --blob_uses_[static_cast<std::size_t>(c)][static_cast<std::size_t>(b)];
   }
 }
 

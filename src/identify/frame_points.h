@@ -8,6 +8,7 @@
 // All storage is sized at construction; load() and the queries allocate nothing.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -36,7 +37,7 @@ class FramePoints {
   int size() const noexcept { return n_; }
   const Vec3& X(int i) const noexcept { return X_[static_cast<std::size_t>(i)]; }
   bool partial(int i) const noexcept { return partial_[static_cast<std::size_t>(i)] != 0; }
-  const std::array<std::int16_t, 2>& blobs(int i) const noexcept {
+  const BlobRefs& blobs(int i) const noexcept {
     return blob_[static_cast<std::size_t>(i)];
   }
   const PointPair* pairs() const noexcept { return pairs_.data(); }
@@ -54,11 +55,11 @@ class FramePoints {
   int n_ = 0;
   int pair_count_ = 0;
   std::vector<Vec3> X_;
-  std::vector<std::array<std::int16_t, 2>> blob_;
+  std::vector<BlobRefs> blob_;
   std::vector<std::uint8_t> valid_;
   std::vector<std::uint8_t> partial_;
   std::vector<std::uint16_t> point_uses_;
-  std::vector<std::uint16_t> blob_uses_[2];
+  std::array<std::vector<std::uint16_t>, kMaxCameras> blob_uses_;  // per camera, per blob
   std::vector<PointPair> pairs_;
 };
 

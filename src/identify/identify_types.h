@@ -9,6 +9,7 @@
 #include <array>
 #include <cstdint>
 
+#include "core/camera_set.h"
 #include "core/types.h"
 
 namespace mocap {
@@ -18,12 +19,12 @@ inline constexpr int kMaxBodies = 16;       // targets per Identifier
 inline constexpr int kMaxPoints = 256;      // measured 3D points per frame (hard bound)
 inline constexpr int kMaxBestPairs = 1024;  // bound of IdentifyConfig::best_pairs
 
-// One triangulated 3D point. blob_index[c] is the blob of camera c (0 or 1) it was
+// One triangulated 3D point. blob_index[c] is the blob of camera c of the rig it was
 // triangulated from, -1 if unknown. Two points sharing a blob in the same camera are
 // mutually exclusive (epipolar ambiguity): a solution uses at most one of them.
 struct MeasuredPoint {
   Vec3 X_world = Vec3::Zero();  // mm
-  std::array<std::int16_t, 2> blob_index{{-1, -1}};
+  BlobRefs blob_index;  // per camera of the rig; -1: not seen by that camera
   // The image of the marker does not look whole in some camera (partly occluded, split
   // from a merged blob, cut by the border): its centroid may be biased. Such a point is
   // identified like any other but left out of the pose fit while 3 whole markers remain.

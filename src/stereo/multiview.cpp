@@ -97,6 +97,26 @@ void MultiViewMerger::refine(Point3& h, const Vec2* const* px) noexcept {
   }
 }
 
+bool MultiViewMerger::refit(Point3& p, const Vec2* const* px) const noexcept {
+  const CameraModel* cams[kMaxCameras];
+  Vec2 obs[kMaxCameras];
+  int k = 0;
+  for (int c = 0; c < camera_count(); ++c) {
+    const int j = p.blob_index[c];
+    if (j < 0) continue;
+    cams[k] = &cams_[static_cast<std::size_t>(c)];
+    obs[k++] = px[c][j];
+  }
+  if (k < 2) return false;
+  Vec3 X = p.X_world;
+  double rms = 0.0;
+  // From a point the dropped view pulled by at most the gate: a few steps converge.
+  if (!refine_gauss_newton(cams, obs, k, X, rms, 2 * kRefineIterations)) return false;
+  p.X_world = X;
+  p.reproj_px = rms;
+  return true;
+}
+
 bool MultiViewMerger::process(const Vec2* const* px, const int* n, const PointList* const* pairs,
                               int pair_count, PointList& out) noexcept {
   ++counters_.frames;
@@ -140,9 +160,7 @@ bool MultiViewMerger::process(const Vec2* const* px, const int* n, const PointLi
       h = hyp_[static_cast<std::size_t>(same)];  // refined already
     else
       refine(h, px);
-    int v = 0;
-    for (std::int16_t j : h.blob_index) v += j >= 0 ? 1 : 0;
-    views_[static_cast<std::size_t>(i)] = v;
+    views_[static_cast<std::size_t>(i)] = h.blob_index.count();
     order_[static_cast<std::size_t>(i)] = i;
   }
   std::sort(order_.begin(), order_.begin() + count, [&](int a, int b) {
@@ -174,9 +192,7 @@ bool MultiViewMerger::process(const Vec2* const* px, const int* n, const PointLi
       }
       if (owner >= 0 && o != owner) all_same_owner = false;
       owner = o;
-      int owner_views = 0;
-      for (std::int16_t b : out[o].blob_index) owner_views += b >= 0 ? 1 : 0;
-      richer_owner = richer_owner || owner_views > views;
+      richer_owner = richer_owner || out[o].blob_index.count() > views;
     }
     if (owner >= 0 && all_same_owner && !any_free) {
       ++counters_.merged;  // the same blobs: the same point from another pair

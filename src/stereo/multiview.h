@@ -67,6 +67,13 @@ class MultiViewMerger {
   bool process(const Vec2* const* px, const int* n, const PointList* const* pairs, int pair_count,
                PointList& out) noexcept;
 
+  // Refits p over exactly the views in p.blob_index (at least two; px as for process()):
+  // Gauss-Newton on the real-pixel reprojection error from p.X_world; updates X_world and
+  // reproj_px. Used when some views were found unfit afterwards (a partly hidden
+  // marker's biased centroid) and the others suffice. False with fewer than two views
+  // or a point behind a camera (p unchanged).
+  bool refit(Point3& p, const Vec2* const* px) const noexcept;
+
   int camera_count() const noexcept { return static_cast<int>(cams_.size()); }
   const MultiViewCounters& counters() const noexcept { return counters_; }
 
@@ -79,7 +86,7 @@ class MultiViewMerger {
   MultiViewConfig config_;
   std::vector<Point3> hyp_;  // workspace: this frame's hypotheses
   std::vector<int> views_;   // views per hypothesis
-  std::vector<std::array<std::int16_t, kMaxCameras>> extended_;  // blobs before refinement
+  std::vector<BlobRefs> extended_;  // blobs before refinement
   std::vector<int> order_;                                       // hypotheses in acceptance order
   std::vector<int> taken_by_;  // [camera * max_points_per_camera + blob]: output index
   MultiViewCounters counters_;

@@ -12,12 +12,10 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/camera_set.h"
 #include "core/types.h"
 
 namespace mocap {
-
-// Cameras a candidate can refer to (the rig's first kMaxCameras cameras).
-inline constexpr int kMaxCameras = 4;
 
 // Camera pairs for rigs with more than two cameras: one StereoTriangulator per pair.
 inline constexpr int kMaxCameraPairs = kMaxCameras * (kMaxCameras - 1) / 2;
@@ -40,7 +38,7 @@ struct Point3 {
   Vec3 X_world = Vec3::Zero();  // mm, world frame
   double reproj_px = 0.0;       // RMS reprojection error over the used views, real pixels
   double epipolar_px = 0.0;     // max of the two symmetric epipolar distances (undistorted px)
-  std::array<std::int16_t, kMaxCameras> blob_index{-1, -1, -1, -1};  // -1: camera unused
+  BlobRefs blob_index;  // blob per camera of the rig; -1: camera unused
   bool ambiguous = false;  // shares a blob with another candidate of the same frame
   // Reported as a marker (points.csv): the stereo stage reports exactly the unambiguous
   // candidates; track/point_selection.h then resolves the ambiguous ones by evidence.

@@ -14,23 +14,14 @@ Expected<CollectedCalibration> collect_calibration_input(const std::string& reco
 
   CollectedCalibration result;
   FrameOutput out = proc->make_output();
-  std::array<Image, 2> images;
+  FrameSetLoader loader(*rec);
   const auto& frames = rec->frames();
   for (std::size_t fi = 0; fi < frames.size(); ++fi) {
     const FrameEntry& fe = frames[fi];
-    std::array<ImageView, 2> views;
-    std::array<const ImageView*, 2> present{nullptr, nullptr};
-    for (std::size_t c = 0; c < 2; ++c) {
-      auto loaded = rec->load_frame(static_cast<int>(c), fe.frame, images[c]);
-      if (!loaded) {
-        if (opt.warn)
-          opt.warn(loaded.error().message + " (frame " + std::to_string(fe.frame) + " skipped)");
-      } else if (*loaded == FrameLoad::kOk) {
-        views[c] = images[c].view();
-        present[c] = &views[c];
-      }
-    }
-    proc->process(present[0], present[1], fe.timestamp_ns, out);
+    const FrameSetLoader::Result loaded = loader.load(fe.frame);
+    if (loaded.damaged > 0 && opt.warn)
+      opt.warn(loaded.problem + " (frame " + std::to_string(fe.frame) + " skipped)");
+    proc->process(loader.views(), fe.timestamp_ns, out);
     ++result.frames;
 
     kinematics::CalibrationFrame frame;

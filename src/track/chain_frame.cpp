@@ -63,10 +63,10 @@ void ChainSolver::solve(const MeasuredPoint* pts, int n, std::int64_t t_ns,
 
   if (config_.enabled && nj > 0) {
     // 1. Points of found bodies, and their epipolar ghosts, are not available.
-    std::array<std::bitset<kBlobBits>, 2> used_blob;
+    std::array<std::bitset<kBlobBits>, kMaxCameras> used_blob;
     const auto take = [&](int p) {
       available_[static_cast<std::size_t>(p)] = false;
-      for (std::size_t c = 0; c < 2; ++c) {
+      for (std::size_t c = 0; c < used_blob.size(); ++c) {
         const int bi = pts[p].blob_index[c];
         if (bi >= 0 && static_cast<std::size_t>(bi) < kBlobBits)
           used_blob[c].set(static_cast<std::size_t>(bi));
@@ -80,7 +80,7 @@ void ChainSolver::solve(const MeasuredPoint* pts, int n, std::int64_t t_ns,
     }
     const auto ghost_check = [&]() {
       for (int p = 0; p < n; ++p) {
-        for (std::size_t c = 0; c < 2; ++c) {
+        for (std::size_t c = 0; c < used_blob.size(); ++c) {
           const int bi = pts[p].blob_index[c];
           if (bi >= 0 && static_cast<std::size_t>(bi) < kBlobBits &&
               used_blob[c].test(static_cast<std::size_t>(bi)))

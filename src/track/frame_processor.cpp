@@ -11,19 +11,31 @@ namespace mocap {
 Expected<FrameProcessor> FrameProcessor::create(const Rig& rig, const TargetSet& targets,
                                                 const JointModel* model,
                                                 const TrackerConfig& config) {
-  if (rig.cameras.size() < 2) {
-    return Error{"rig: the tracker needs two cameras (the stereo pair), the rig has " +
-                 std::to_string(rig.cameras.size())};
+  const int n_cams = static_cast<int>(rig.cameras.size());
+  if (n_cams < kMinCameras || n_cams > kMaxCameras) {
+    return Error{"rig: the tracker takes " + std::to_string(kMinCameras) + " to " +
+                 std::to_string(kMaxCameras) + " cameras, the rig has " + std::to_string(n_cams)};
   }
-  std::array<std::optional<detect::BlobDetector>, 2> dets;
-  for (int c = 0; c < 2; ++c) {
-    const CameraModel& cam = rig.cameras[static_cast<std::size_t>(c)];
+  std::vector<detect::BlobDetector> dets;
+  for (const CameraModel& cam : rig.cameras) {
     auto d = detect::BlobDetector::create(config.detect, cam.width, cam.height);
     if (!d) return Error{"detection (" + cam.name + "): " + d.error().message};
-    dets[static_cast<std::size_t>(c)].emplace(std::move(d).value());
+    dets.push_back(std::move(d).value());
   }
-  auto stereo = StereoTriangulator::create(rig, config.stereo, 0, 1);
-  if (!stereo) return Error{"stereo: " + stereo.error().message};
+  std::array<CameraPair, kMaxCameraPairs> camera_pairs{};
+  const int n_pairs = enumerate_camera_pairs(n_cams, camera_pairs);
+  std::vector<StereoTriangulator> pairs;
+  for (int k = 0; k < n_pairs; ++k) {
+    const CameraPair cp = camera_pairs[static_cast<std::size_t>(k)];
+    auto stereo = StereoTriangulator::create(rig, config.stereo, cp.a, cp.b);
+    if (!stereo) return Error{"stereo: " + stereo.error().message};
+    pairs.push_back(std::move(stereo).value());
+  }
+  MultiViewConfig mvc = config.multiview;
+  mvc.max_points_per_camera = config.stereo.max_points_per_camera;
+  mvc.max_hypotheses = std::max(1, config.stereo.max_candidates) * std::max(1, n_pairs);
+  auto merger = MultiViewMerger::create(rig, mvc);
+  if (!merger) return Error{"multi-view: " + merger.error().message};
   auto ident = Identifier::create(targets, config.identify);
   if (!ident) return Error{"identification: " + ident.error().message};
 
@@ -35,11 +47,10 @@ Expected<FrameProcessor> FrameProcessor::create(const Rig& rig, const TargetSet&
     angles.emplace(std::move(solver).value());
     model_copy = *model;
   }
-  FrameProcessor p(rig, targets, std::move(model_copy), {std::move(*dets[0]), std::move(*dets[1])},
-                   std::move(stereo).value(), std::move(ident).value(), std::move(angles));
-  for (int c = 0; c < 2; ++c) {
-    auto shape = MarkerShapeModel::create(rig.cameras[static_cast<std::size_t>(c)],
-                                          targets.marker_diameter_mm, config.marker_shape);
+  FrameProcessor p(rig, targets, std::move(model_copy), std::move(dets), std::move(pairs),
+                   std::move(merger).value(), std::move(ident).value(), std::move(angles));
+  for (const CameraModel& cam : rig.cameras) {
+    auto shape = MarkerShapeModel::create(cam, targets.marker_diameter_mm, config.marker_shape);
     if (!shape) return shape.error();
     p.shapes_.push_back(std::move(shape).value());
   }
@@ -66,28 +77,33 @@ Expected<FrameProcessor> FrameProcessor::create(const Rig& rig, const TargetSet&
     for (const std::string& w : p.chain_->model().warnings())
       p.warnings_.push_back("chain tracking: " + w);
   }
-  for (auto& c : p.centroids_px_) c.resize(static_cast<std::size_t>(config.detect.max_blobs));
+  p.centroids_px_.assign(static_cast<std::size_t>(n_cams),
+                         std::vector<Vec2>(static_cast<std::size_t>(config.detect.max_blobs)));
+  if (n_cams > 2)
+    p.pair_points_.assign(static_cast<std::size_t>(n_pairs), PointList(config.stereo.max_candidates));
   p.measured_.resize(static_cast<std::size_t>(std::max(1, config.stereo.max_candidates)));
   p.body_views_.resize(targets.bodies.size());
   return p;
 }
 
 FrameProcessor::FrameProcessor(Rig rig, TargetSet targets, JointModel model,
-                               std::array<detect::BlobDetector, 2> detectors,
-                               StereoTriangulator stereo, Identifier identifier,
+                               std::vector<detect::BlobDetector> detectors,
+                               std::vector<StereoTriangulator> pairs, MultiViewMerger merger,
+                               Identifier identifier,
                                std::optional<kinematics::JointAngleSolver> angles)
     : rig_(std::move(rig)),
       targets_(std::move(targets)),
       model_(std::move(model)),
       detectors_(std::move(detectors)),
-      stereo_(std::move(stereo)),
+      pairs_(std::move(pairs)),
+      merger_(std::move(merger)),
       identifier_(std::move(identifier)),
       angles_(std::move(angles)) {}
 
 FrameOutput FrameProcessor::make_output() const {
   FrameOutput out;
-  for (std::size_t c = 0; c < 2; ++c) out.blobs[c] = detectors_[c].make_blob_list();
-  out.points.set_capacity(stereo_.config().max_candidates);
+  for (const detect::BlobDetector& d : detectors_) out.blobs.push_back(d.make_blob_list());
+  out.points.set_capacity(pairs_.front().config().max_candidates);
   out.poses.count = identifier_.body_count();
   if (angles_) out.angles = angles_->make_output();
   return out;
@@ -95,18 +111,19 @@ FrameOutput FrameProcessor::make_output() const {
 
 bool FrameProcessor::detect_camera(int camera, const ImageView& image,
                                    detect::BlobList& out) noexcept {
-  if (camera < 0 || camera > 1) return false;
+  if (camera < 0 || camera >= camera_count()) return false;
   return detectors_[static_cast<std::size_t>(camera)].detect(image, out);
 }
 
-bool FrameProcessor::process(const ImageView* cam0, const ImageView* cam1,
+bool FrameProcessor::process(std::span<const ImageView* const> views,
                              std::int64_t timestamp_ns, FrameOutput& out) noexcept {
   const std::int64_t t0 = monotonic_ns();
-  const ImageView* views[2] = {cam0, cam1};
-  for (std::size_t c = 0; c < 2; ++c) {
-    out.blobs[c].clear();
-    out.camera_present[c] = views[c] != nullptr;
-    if (views[c] != nullptr) detect_camera(static_cast<int>(c), *views[c], out.blobs[c]);
+  for (int c = 0; c < camera_count(); ++c) {
+    const auto uc = static_cast<std::size_t>(c);
+    const ImageView* view = uc < views.size() ? views[uc] : nullptr;
+    out.blobs[uc].clear();
+    out.camera_present[uc] = view != nullptr;
+    if (view != nullptr) detect_camera(c, *view, out.blobs[uc]);
   }
   out.times.detect = monotonic_ns() - t0;
   const bool ok = process_blobs(timestamp_ns, out);
@@ -114,40 +131,116 @@ bool FrameProcessor::process(const ImageView* cam0, const ImageView* cam1,
   return ok;
 }
 
-bool FrameProcessor::process_blobs(std::int64_t timestamp_ns, FrameOutput& out) noexcept {
-  // Stereo + triangulation: only when both cameras delivered this frame.
-  std::int64_t t = monotonic_ns();
+void FrameProcessor::triangulate(FrameOutput& out) noexcept {
   out.points.clear();
-  if (out.camera_present[0] && out.camera_present[1]) {
-    std::array<int, 2> n{};
-    for (std::size_t c = 0; c < 2; ++c) {
-      const detect::BlobList& blobs = out.blobs[c];
-      std::vector<Vec2>& px = centroids_px_[c];
-      const std::size_t count = std::min(blobs.size(), px.size());
-      for (std::size_t i = 0; i < count; ++i) px[i] = Vec2(blobs[i].x_px, blobs[i].y_px);
-      n[c] = static_cast<int>(count);
-    }
-    stereo_.process(centroids_px_[0].data(), n[0], centroids_px_[1].data(), n[1], out.points);
+  const int n_cams = camera_count();
+  const Vec2* px[kMaxCameras] = {};
+  int n[kMaxCameras] = {};
+  int present = 0;
+  for (int c = 0; c < n_cams; ++c) {
+    const auto uc = static_cast<std::size_t>(c);
+    if (!out.camera_present[uc]) continue;
+    ++present;
+    const detect::BlobList& blobs = out.blobs[uc];
+    std::vector<Vec2>& centroids = centroids_px_[uc];
+    const std::size_t count = std::min(blobs.size(), centroids.size());
+    for (std::size_t i = 0; i < count; ++i) centroids[i] = Vec2(blobs[i].x_px, blobs[i].y_px);
+    px[c] = centroids.data();
+    n[c] = static_cast<int>(count);
   }
+  if (present < 2) return;
+  if (n_cams == 2) {  // the stereo pair straight into the output: the paper's path
+    pairs_.front().process(px[0], n[0], px[1], n[1], out.points);
+    stereo_total_ = pairs_.front().counters();
+    return;
+  }
+  const PointList* lists[kMaxCameraPairs] = {};
+  int listed = 0;
+  for (std::size_t k = 0; k < pairs_.size(); ++k) {
+    StereoTriangulator& st = pairs_[k];
+    const int a = st.camera_a(), b = st.camera_b();
+    if (!out.camera_present[static_cast<std::size_t>(a)] ||
+        !out.camera_present[static_cast<std::size_t>(b)])
+      continue;
+    st.process(px[a], n[a], px[b], n[b], pair_points_[k]);
+    lists[listed++] = &pair_points_[k];
+  }
+  merger_.process(px, n, lists, listed, out.points);
+  sum_stereo_counters();
+}
+
+void FrameProcessor::sum_stereo_counters() noexcept {
+  StereoCounters t;
+  for (const StereoTriangulator& st : pairs_) {
+    const StereoCounters& c = st.counters();
+    t.frames = std::max(t.frames, c.frames);
+    for (std::size_t i = 0; i < 2; ++i) {
+      t.points_in[i] += c.points_in[i];
+      t.points_overflow[i] += c.points_overflow[i];
+      t.undistort_failed[i] += c.undistort_failed[i];
+    }
+    t.pairs_in_tolerance += c.pairs_in_tolerance;
+    t.rejected_degenerate += c.rejected_degenerate;
+    t.rejected_cheirality += c.rejected_cheirality;
+    t.rejected_depth += c.rejected_depth;
+    t.rejected_reproj += c.rejected_reproj;
+    t.candidates += c.candidates;
+    t.ambiguous += c.ambiguous;
+    t.candidate_overflow += c.candidate_overflow;
+    t.bad_input += c.bad_input;
+  }
+  stereo_total_ = t;
+}
+
+void FrameProcessor::measure_points(FrameOutput& out) noexcept {
+  const int n_points = std::min(out.points.size(), static_cast<int>(measured_.size()));
+  const Vec2* px[kMaxCameras] = {};
+  for (int c = 0; c < camera_count(); ++c) px[c] = centroids_px_[static_cast<std::size_t>(c)].data();
+  for (int i = 0; i < n_points; ++i) {
+    Point3& p = out.points[i];
+    // Which views look like a whole marker at the point's position.
+    BlobRefs whole = p.blob_index;
+    int n_whole = 0;
+    for (int c = 0; c < camera_count(); ++c) {
+      const int b = p.blob_index[c];
+      if (b < 0) continue;
+      if (whole_marker_view(c, out.blobs[static_cast<std::size_t>(c)], b, p.X_world))
+        ++n_whole;
+      else
+        whole[c] = -1;
+    }
+    const int views = p.blob_index.count();
+    bool partial = n_whole < views;
+    if (partial && n_whole >= 2) {
+      // Enough whole views: the point is measured from them alone (its other blobs
+      // still belong to it, for exclusivity and the reported set).
+      Point3 refit = p;
+      refit.blob_index = whole;
+      if (merger_.refit(refit, px)) {
+        p.X_world = refit.X_world;
+        p.reproj_px = refit.reproj_px;
+        partial = false;
+      }
+    }
+    MeasuredPoint& m = measured_[static_cast<std::size_t>(i)];
+    m.X_world = p.X_world;
+    m.blob_index = p.blob_index;
+    m.partial = partial;
+  }
+  measured_count_ = n_points;
+}
+
+bool FrameProcessor::process_blobs(std::int64_t timestamp_ns, FrameOutput& out) noexcept {
+  // Correspondence + triangulation over the cameras that delivered this frame.
+  std::int64_t t = monotonic_ns();
+  triangulate(out);
   std::int64_t now = monotonic_ns();
   out.times.triangulate = now - t;
 
   // Identification.
   t = now;
-  const int n_points = std::min(out.points.size(), static_cast<int>(measured_.size()));
-  for (int i = 0; i < n_points; ++i) {
-    const Point3& p = out.points[i];
-    MeasuredPoint& m = measured_[static_cast<std::size_t>(i)];
-    m.X_world = p.X_world;
-    m.blob_index = {p.blob_index[0], p.blob_index[1]};
-    m.partial = false;
-    for (int c = 0; c < 2; ++c) {
-      const int b = p.blob_index[static_cast<std::size_t>(c)];
-      if (!whole_marker_view(c, out.blobs[static_cast<std::size_t>(c)], b, p.X_world))
-        m.partial = true;
-    }
-  }
-  measured_count_ = n_points;
+  measure_points(out);
+  const int n_points = measured_count_;
   const bool identified = identifier_.identify(measured_.data(), n_points, timestamp_ns, out.poses);
   // Kinematic-chain tracking (with a model): bodies solved through their joints join the
   // poses, so the point selection below counts their points as used.

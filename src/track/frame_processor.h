@@ -1,15 +1,26 @@
 // Design: the per-frame stages of the tracker in one object, shared by the offline
-// `mocap track` and the live pipeline: detect (one detector per camera) -> stereo
-// correspondence + optimal triangulation -> rigid-target identification -> joint angles.
+// `mocap track` and the live pipeline: detect (one detector per camera) -> correspondence
+// + optimal triangulation -> rigid-target identification -> joint angles.
+// Cameras: the rig's 2..kMaxCameras cameras all take part. Two cameras: one stereo pair
+// (stereo_triangulator.h), exactly as the paper. More: one triangulator per camera pair
+// proposes candidates and the MultiViewMerger (multiview.h) merges them into N-view
+// points refined over every camera that sees them; a view whose blob does not look like
+// a whole marker (marker_shape.h) is then left out of the point when two or more whole
+// views remain, so an occluded view no longer biases a point other cameras see clearly.
+// A camera whose frame is missing takes no part in that frame: with two cameras the
+// frame yields no 3D points (spec); with more, the others still triangulate (at least
+// two present).
 // Immutable configuration plus preallocated workspace: create() validates and allocates
 // every buffer from the stated bounds; the per-frame calls are noexcept, allocate
 // nothing and never throw. The live pipeline calls the stages separately (detect_camera()
-// on two threads, then process_blobs()); `process()` runs them in sequence and times them.
+// on the detect threads, then process_blobs()); `process()` runs them in sequence and
+// times them.
 #pragma once
 
 #include <array>
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -20,6 +31,7 @@
 #include "formats/joints_yaml.h"
 #include "formats/targets_yaml.h"
 #include "identify/identifier.h"
+#include "stereo/multiview.h"
 #include "kinematics/joint_angles.h"
 #include "stereo/stereo_triangulator.h"
 #include "track/chain_solver.h"
@@ -35,6 +47,8 @@ struct TrackerConfig {
     return c;
   }()};
   StereoConfig stereo{};
+  // Rigs with more than two cameras: the N-view merge (its capacities follow `stereo`).
+  MultiViewConfig multiview{};
   IdentifyConfig identify{[] {
     IdentifyConfig c;
     c.max_speed_mm_per_s = 3000.0;
@@ -55,7 +69,7 @@ struct TrackerConfig {
   ChainConfig chain{};
 };
 
-// Wall-clock duration of each stage of one frame (ns). `detect` covers both cameras.
+// Wall-clock duration of each stage of one frame (ns). `detect` covers every camera.
 struct StageTimesNs {
   std::int64_t detect = 0;
   std::int64_t triangulate = 0;
@@ -66,8 +80,8 @@ struct StageTimesNs {
 
 // Everything one frame produces; sized by FrameProcessor::make_output() at setup.
 struct FrameOutput {
-  std::array<detect::BlobList, 2> blobs;
-  std::array<bool, 2> camera_present{};  // false: the camera's frame was missing
+  std::vector<detect::BlobList> blobs;            // one per camera of the rig
+  std::array<bool, kMaxCameras> camera_present{};  // false: the camera's frame was missing
   PointList points;
   BodyPoses poses;
   kinematics::JointAngles angles;
@@ -76,18 +90,18 @@ struct FrameOutput {
 
 class FrameProcessor {
  public:
-  // `model` may be null (no joint angles). The rig's first two cameras are the stereo pair.
+  // `model` may be null (no joint angles). Every camera of the rig (2..kMaxCameras) is used.
   static Expected<FrameProcessor> create(const Rig& rig, const TargetSet& targets,
                                          const JointModel* model, const TrackerConfig& config);
 
   FrameOutput make_output() const;
 
-  // All stages of one frame. A null view means that camera's frame is missing: the
-  // frame then yields no 3D points (spec), and identification sees an empty frame.
-  bool process(const ImageView* cam0, const ImageView* cam1, std::int64_t timestamp_ns,
+  // All stages of one frame; views[c] is camera c's image (views beyond views.size()
+  // count as missing). A null view means that camera's frame is missing (see the top).
+  bool process(std::span<const ImageView* const> views, std::int64_t timestamp_ns,
                FrameOutput& out) noexcept;
 
-  // Stage 1 alone, for camera 0 or 1 (thread-safe between the two cameras).
+  // Stage 1 alone, for one camera (thread-safe between different cameras).
   bool detect_camera(int camera, const ImageView& image, detect::BlobList& out) noexcept;
   // Stages 2-4 on the blobs already in `out.blobs` (camera_present must be set).
   bool process_blobs(std::int64_t timestamp_ns, FrameOutput& out) noexcept;
@@ -108,7 +122,11 @@ class FrameProcessor {
   const detect::DetectorCounters& detector_counters(int camera) const noexcept {
     return detectors_[static_cast<std::size_t>(camera)].counters();
   }
-  const StereoCounters& stereo_counters() const noexcept { return stereo_.counters(); }
+  int camera_count() const noexcept { return static_cast<int>(detectors_.size()); }
+  // The pairwise stereo counters summed over the camera pairs (one pair: its own;
+  // points_in[0] and [1] then sum each pair's first and second camera).
+  const StereoCounters& stereo_counters() const noexcept { return stereo_total_; }
+  const MultiViewCounters& multiview_counters() const noexcept { return merger_.counters(); }
   const IdentifyCounters& identify_counters() const noexcept { return identifier_.counters(); }
   // Chain-tracking counters; null without a model.
   const ChainCounters* chain_counters() const noexcept {
@@ -120,8 +138,14 @@ class FrameProcessor {
 
  private:
   FrameProcessor(Rig rig, TargetSet targets, JointModel model,
-                 std::array<detect::BlobDetector, 2> detectors, StereoTriangulator stereo,
-                 Identifier identifier, std::optional<kinematics::JointAngleSolver> angles);
+                 std::vector<detect::BlobDetector> detectors, std::vector<StereoTriangulator> pairs,
+                 MultiViewMerger merger, Identifier identifier,
+                 std::optional<kinematics::JointAngleSolver> angles);
+  // Stereo and N-view merge into out.points from out.blobs and out.camera_present.
+  void triangulate(FrameOutput& out) noexcept;
+  // Marks the identification's input; drops unfit views of points seen by 3+ cameras.
+  void measure_points(FrameOutput& out) noexcept;
+  void sum_stereo_counters() noexcept;
   // Chain tracking after identification: chain-solved bodies join out.poses.
   void track_chain(int n_points, std::int64_t timestamp_ns, FrameOutput& out) noexcept;
   // False when the blob of a marker at X_world does not look like a whole marker.
@@ -129,18 +153,21 @@ class FrameProcessor {
                          const Vec3& X_world) const noexcept;
 
   Rig rig_;
-  std::vector<MarkerShapeModel> shapes_;  // one per stereo camera
+  std::vector<MarkerShapeModel> shapes_;  // one per camera
   TargetSet targets_;
   JointModel model_;
-  std::array<detect::BlobDetector, 2> detectors_;
-  StereoTriangulator stereo_;
+  std::vector<detect::BlobDetector> detectors_;  // one per camera
+  std::vector<StereoTriangulator> pairs_;        // one per camera pair (a < b)
+  MultiViewMerger merger_;
+  StereoCounters stereo_total_;
   Identifier identifier_;
   std::optional<kinematics::JointAngleSolver> angles_;
   std::optional<ChainSolver> chain_;
   ChainResult chain_result_;
   std::vector<std::string> warnings_;
   // Workspace, sized at create().
-  std::array<std::vector<Vec2>, 2> centroids_px_;
+  std::vector<std::vector<Vec2>> centroids_px_;  // per camera
+  std::vector<PointList> pair_points_;           // per camera pair (3+ cameras)
   std::vector<MeasuredPoint> measured_;
   int measured_count_ = 0;
   PointSelector selector_;

@@ -44,7 +44,9 @@ Expected<OfflineTrackResult> track_recording(const OfflineTrackOptions& opt) {
   std::error_code ec;
   std::filesystem::create_directories(opt.out_dir, ec);
   if (ec) return make_error(opt.out_dir, "", "cannot create output folder: " + ec.message());
-  auto points_csv = open_points_csv(opt.out_dir + "/points.csv");
+  // More than two cameras: points.csv adds the spec's `cameras` column.
+  const bool multi_camera = rec->rig().cameras.size() > 2;
+  auto points_csv = open_points_csv(opt.out_dir + "/points.csv", multi_camera);
   if (!points_csv) return points_csv.error();
   auto poses_csv = open_poses_csv(opt.out_dir + "/poses.csv");
   if (!poses_csv) return poses_csv.error();
@@ -71,33 +73,21 @@ Expected<OfflineTrackResult> track_recording(const OfflineTrackOptions& opt) {
   }
 
   FrameOutput out = proc->make_output();
-  std::array<Image, 2> images;
+  FrameSetLoader loader(*rec);
   PointRow point_row;
   PoseRow pose_row;
   AngleRow angle_row;
   for (std::size_t fi = 0; fi < frames.size(); ++fi) {
     const FrameEntry& fe = frames[fi];
-    std::array<const ImageView*, 2> present{nullptr, nullptr};
-    std::array<ImageView, 2> views;
-    bool missing = false, damaged = false;
-    for (int c = 0; c < 2; ++c) {
-      auto loaded = rec->load_frame(c, fe.frame, images[static_cast<std::size_t>(c)]);
-      if (!loaded) {
-        damaged = true;
-        if (opt.warn)
-          opt.warn(loaded.error().message + " (frame " + std::to_string(fe.frame) +
-                   " treated as dropped)");
-      } else if (*loaded == FrameLoad::kMissing) {
-        missing = true;
-      } else {
-        views[static_cast<std::size_t>(c)] = images[static_cast<std::size_t>(c)].view();
-        present[static_cast<std::size_t>(c)] = &views[static_cast<std::size_t>(c)];
-      }
-    }
+    const FrameSetLoader::Result loaded = loader.load(fe.frame);
+    const bool missing = loaded.missing > 0;
+    const bool damaged = loaded.damaged > 0;
+    if (damaged && opt.warn)
+      opt.warn(loaded.problem + " (frame " + std::to_string(fe.frame) + " treated as dropped)");
     result.frames_missing += missing ? 1 : 0;
     result.frames_damaged += damaged ? 1 : 0;
 
-    proc->process(present[0], present[1], fe.timestamp_ns, out);
+    proc->process(loader.views(), fe.timestamp_ns, out);
     result.stats->record(out.times);
     ++result.stats->frames;
     ++result.frames;
@@ -108,6 +98,7 @@ Expected<OfflineTrackResult> track_recording(const OfflineTrackOptions& opt) {
       point_row.frame = fe.frame;
       point_row.X_world = p.X_world;
       point_row.reproj_px = p.reproj_px;
+      point_row.cameras = multi_camera ? p.blob_index.count() : 0;
       write_row(*points_csv, point_row);
       ++result.points;
     }

@@ -6,7 +6,7 @@ namespace mocap {
 
 std::vector<std::pair<std::string, std::uint64_t>> collect_counters(const FrameProcessor& p) {
   std::vector<std::pair<std::string, std::uint64_t>> c;
-  for (int cam = 0; cam < 2; ++cam) {
+  for (int cam = 0; cam < p.camera_count(); ++cam) {
     const detect::DetectorCounters& d = p.detector_counters(cam);
     const std::string k = "detect_cam" + std::to_string(cam) + "_";
     c.emplace_back(k + "frames", d.frames);
@@ -26,6 +26,16 @@ std::vector<std::pair<std::string, std::uint64_t>> collect_counters(const FrameP
   c.emplace_back("stereo_rejected_reproj", s.rejected_reproj);
   c.emplace_back("stereo_candidate_overflow", s.candidate_overflow);
   c.emplace_back("stereo_points_overflow", s.points_overflow[0] + s.points_overflow[1]);
+  if (p.camera_count() > 2) {
+    const MultiViewCounters& m = p.multiview_counters();
+    c.emplace_back("multiview_views_added", m.views_added);
+    c.emplace_back("multiview_views_dropped", m.views_dropped);
+    c.emplace_back("multiview_merged", m.merged);
+    c.emplace_back("multiview_ghosts_rejected", m.ghosts_rejected);
+    c.emplace_back("multiview_ambiguous", m.ambiguous);
+    c.emplace_back("multiview_hypothesis_overflow", m.hypothesis_overflow);
+    c.emplace_back("multiview_point_overflow", m.point_overflow);
+  }
   const IdentifyCounters& i = p.identify_counters();
   c.emplace_back("identify_bodies_found", i.bodies_found);
   c.emplace_back("identify_full_searches", i.full_searches);

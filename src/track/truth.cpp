@@ -32,6 +32,8 @@ std::map<std::pair<std::int64_t, std::string>, const Row*> index_rows(const std:
 
 }  // namespace
 
+// gt/markers.csv: frame,body,marker,x,y,z, then uK,vK,visK for every camera K in rig
+// order (at least cameras 0 and 1), then possibly further columns (ignored).
 Expected<std::vector<GtMarker>> read_gt_markers_csv(const std::string& path) {
   std::ifstream in(path);
   if (!in) return make_error(path, "", "cannot open");
@@ -41,24 +43,43 @@ Expected<std::vector<GtMarker>> read_gt_markers_csv(const std::string& path) {
     return make_error(path, "line 1",
                       "expected header frame,body,marker,x,y,z,u0,v0,vis0,u1,v1,vis1");
   }
+  std::vector<std::string> names;
+  {
+    std::stringstream hs(line);
+    for (std::string h; std::getline(hs, h, ',');) names.push_back(h);
+  }
+  int cameras = 0;
+  while (cameras < kMaxCameras) {
+    const std::size_t col = 6 + 3 * static_cast<std::size_t>(cameras);
+    const std::string k = std::to_string(cameras);
+    if (col + 2 >= names.size() || names[col] != "u" + k || names[col + 1] != "v" + k ||
+        names[col + 2] != "vis" + k)
+      break;
+    ++cameras;
+  }
+  const std::size_t fields = 6 + 3 * static_cast<std::size_t>(cameras);
   std::vector<GtMarker> out;
   int line_no = 1;
+  std::vector<std::string> f(fields);
   while (std::getline(in, line)) {
     ++line_no;
     if (line.empty()) continue;
     std::stringstream ss(line);
-    std::string f[12];
-    for (auto& s : f) std::getline(ss, s, ',');
+    for (auto& s : f) {
+      s.clear();
+      std::getline(ss, s, ',');
+    }
     GtMarker m;
+    m.cameras = cameras;
     try {
       m.frame = std::stoll(f[0]);
       m.body = f[1];
       m.marker = std::stoi(f[2]);
       m.X_world = Vec3(std::stod(f[3]), std::stod(f[4]), std::stod(f[5]));
-      m.px[0] = Vec2(std::stod(f[6]), std::stod(f[7]));
-      m.visible[0] = std::stoi(f[8]) != 0;
-      m.px[1] = Vec2(std::stod(f[9]), std::stod(f[10]));
-      m.visible[1] = std::stoi(f[11]) != 0;
+      for (std::size_t c = 0; c < static_cast<std::size_t>(cameras); ++c) {
+        m.px[c] = Vec2(std::stod(f[6 + 3 * c]), std::stod(f[7 + 3 * c]));
+        m.visible[c] = std::stoi(f[8 + 3 * c]) != 0;
+      }
     } catch (const std::exception&) {
       return make_error(path, "line " + std::to_string(line_no), "malformed row");
     }
@@ -141,7 +162,7 @@ AccuracyReport evaluate_against_truth(const GroundTruth& truth, const std::vecto
                                       const std::vector<PoseRow>& poses,
                                       const std::vector<AngleRow>& angles) {
   AccuracyReport rep;
-  // Points: per frame, nearest point to each doubly visible marker.
+  // Points: per frame, nearest point to each marker visible in two or more cameras.
   std::map<std::int64_t, std::vector<const PointRow*>> points_by_frame;
   for (const PointRow& p : points) points_by_frame[p.frame].push_back(&p);
   std::map<std::int64_t, std::vector<const GtMarker*>> markers_by_frame;
@@ -150,7 +171,7 @@ AccuracyReport evaluate_against_truth(const GroundTruth& truth, const std::vecto
   for (const auto& [frame, markers] : markers_by_frame) {
     const auto it = points_by_frame.find(frame);
     for (const GtMarker* m : markers) {
-      if (!(m->visible[0] && m->visible[1])) continue;
+      if (m->views() < 2) continue;
       ++rep.marker_views;
       if (it == points_by_frame.end()) continue;
       double best = 1e300;
@@ -186,7 +207,7 @@ AccuracyReport evaluate_against_truth(const GroundTruth& truth, const std::vecto
   }
   std::map<std::pair<std::int64_t, std::string>, int> visible_count;
   for (const GtMarker& m : truth.markers) {
-    if (m.visible[0] && m.visible[1]) ++visible_count[{m.frame, m.body}];
+    if (m.views() >= 2) ++visible_count[{m.frame, m.body}];
   }
   std::set<std::int64_t> frames;
   for (const PoseRow& p : truth.poses) frames.insert(p.frame);
@@ -257,7 +278,7 @@ std::string format_accuracy(const AccuracyReport& r) {
   std::snprintf(
       buf, sizeof buf,
       "accuracy against ground truth (%lld frames)\n"
-      "  3D points: recall %.2f%% (%lld of %lld markers seen by both cameras), "
+      "  3D points: recall %.2f%% (%lld of %lld markers seen by 2+ cameras), "
       "RMSE %.4f mm, %lld of %lld points far (> 5 mm) from any marker\n",
       static_cast<long long>(r.frames),
       r.marker_views

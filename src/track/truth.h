@@ -3,6 +3,8 @@
 // `mocap track --truth`, the end-to-end tests and the evaluation script. Offline only.
 #pragma once
 
+#include <algorithm>
+
 #include <array>
 #include <cstdint>
 #include <string>
@@ -12,6 +14,7 @@
 #include "core/types.h"
 #include "formats/csv_outputs.h"
 #include "formats/joints_yaml.h"
+#include "core/camera_set.h"
 #include "formats/targets_yaml.h"
 
 namespace mocap {
@@ -21,8 +24,13 @@ struct GtMarker {
   std::string body;
   int marker = 0;
   Vec3 X_world = Vec3::Zero();
-  std::array<Vec2, 2> px{Vec2::Zero(), Vec2::Zero()};
-  std::array<bool, 2> visible{false, false};  // visible, unmerged, inside the image
+  int cameras = 0;                      // cameras of the recording (columns uK,vK,visK)
+  std::array<Vec2, kMaxCameras> px{};     // per camera, the first `cameras` entries
+  std::array<bool, kMaxCameras> visible{};  // visible, unmerged, inside the image
+  // Cameras that see the marker cleanly; a 3D point is expected from two or more.
+  int views() const noexcept {
+    return static_cast<int>(std::count(visible.begin(), visible.end(), true));
+  }
 };
 
 struct GroundTruth {
@@ -43,7 +51,7 @@ Expected<std::vector<GtMarker>> read_gt_markers_csv(const std::string& path);
 
 struct BodyAccuracy {
   std::string body;
-  std::int64_t frames_visible = 0;  // frames with >= 3 of its markers visible in both cameras
+  std::int64_t frames_visible = 0;  // frames with >= 3 of its markers visible in >= 2 cameras
   std::int64_t frames_found = 0;    // of those, frames where the tracker found the body
   std::int64_t frames_found_total = 0;
   std::int64_t wrong = 0;           // found with a pose far from the truth (> 10 mm or > 5 deg)
@@ -60,7 +68,7 @@ struct JointAccuracy {
 
 struct AccuracyReport {
   std::int64_t frames = 0;
-  std::int64_t marker_views = 0;     // markers visible in both cameras, summed over frames
+  std::int64_t marker_views = 0;     // markers visible in >= 2 cameras, summed over frames
   std::int64_t markers_recalled = 0;  // of those, with a 3D point within 2 mm
   double point_rmse_mm = 0.0;         // over recalled markers
   std::int64_t points = 0;            // all 3D points written

@@ -151,6 +151,26 @@ TEST_F(RigYamlTest, EmptyCameras) {
   EXPECT_THAT(error_of("cameras: []\n"), AllOf(HasSubstr("cameras: empty list")));
 }
 
+TEST_F(RigYamlTest, EightCamerasAtMost) {
+  Rig rig = test::make_test_rig();
+  while (rig.cameras.size() < 9) {
+    CameraModel c = rig.cameras[0];
+    c.name = "cam" + std::to_string(rig.cameras.size());
+    rig.cameras.push_back(c);
+  }
+  const std::string path = dir.file("nine.yaml");
+  ASSERT_TRUE(save_rig(path, rig).ok());
+  auto r = load_rig(path);
+  ASSERT_FALSE(r.ok());
+  EXPECT_THAT(r.error().message,
+              AllOf(StartsWith(path + ": cameras: 9 cameras, at most 8 are supported")));
+  rig.cameras.pop_back();
+  ASSERT_TRUE(save_rig(path, rig).ok());
+  auto eight = load_rig(path);
+  ASSERT_TRUE(eight.ok()) << eight.error().message;
+  EXPECT_EQ(eight->cameras.size(), 8u);
+}
+
 TEST_F(RigYamlTest, MissingKeyNamesCameraAndKey) {
   EXPECT_THAT(error_of(valid_with("    fy: 1289.5\n", "")),
               HasSubstr("cameras[1].fy: missing key"));

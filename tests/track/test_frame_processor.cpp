@@ -1,5 +1,6 @@
 // Tests of the FrameProcessor: steady-state processing allocates nothing, a missing
 // camera frame yields no 3D points, damaged images never crash.
+#include <array>
 #include <gtest/gtest.h>
 
 #include "formats/recording.h"
@@ -50,18 +51,18 @@ TEST(FrameProcessor, SteadyStateProcessingAllocatesNothing) {
   // Warm up: the first frames may take the cold identification path.
   for (std::size_t i = 0; i < 4; ++i) {
     const ImageView v0 = l.images[i][0].view(), v1 = l.images[i][1].view();
-    proc->process(&v0, &v1, l.rec.frames()[i].timestamp_ns, out);
+    proc->process(std::array<const ImageView*, 2>{&v0, &v1}, l.rec.frames()[i].timestamp_ns, out);
   }
   test::AllocationScope scope;
   int bodies = 0;
   for (std::size_t i = 4; i < l.images.size(); ++i) {
     const ImageView v0 = l.images[i][0].view(), v1 = l.images[i][1].view();
-    proc->process(&v0, &v1, l.rec.frames()[i].timestamp_ns, out);
+    proc->process(std::array<const ImageView*, 2>{&v0, &v1}, l.rec.frames()[i].timestamp_ns, out);
     bodies += out.poses.found;
   }
   proc->reset();  // and the cold path too
   const ImageView v0 = l.images[0][0].view(), v1 = l.images[0][1].view();
-  proc->process(&v0, &v1, l.rec.frames()[0].timestamp_ns + 1000000000, out);
+  proc->process(std::array<const ImageView*, 2>{&v0, &v1}, l.rec.frames()[0].timestamp_ns + 1000000000, out);
   EXPECT_EQ(scope.count(), 0u);
   EXPECT_GT(bodies, 0);  // the work was real
 }
@@ -73,14 +74,14 @@ TEST(FrameProcessor, MissingCameraFrameYieldsNoPoints) {
   ASSERT_TRUE(proc.ok());
   FrameOutput out = proc->make_output();
   const ImageView v0 = l.images[0][0].view(), v1 = l.images[0][1].view();
-  proc->process(&v0, &v1, 0, out);
+  proc->process(std::array<const ImageView*, 2>{&v0, &v1}, 0, out);
   EXPECT_GT(out.points.size(), 5);
-  proc->process(&v0, nullptr, 10000000, out);
+  proc->process(std::array<const ImageView*, 2>{&v0, nullptr}, 10000000, out);
   EXPECT_EQ(out.points.size(), 0);
   EXPECT_GT(out.blobs[0].size(), 5u);
   EXPECT_FALSE(out.camera_present[1]);
   EXPECT_EQ(out.poses.found, 0);
-  proc->process(&v0, &v1, 20000000, out);  // and it goes on
+  proc->process(std::array<const ImageView*, 2>{&v0, &v1}, 20000000, out);  // and it goes on
   EXPECT_GT(out.points.size(), 5);
 }
 
@@ -100,21 +101,21 @@ TEST(FrameProcessor, DamagedImagesNeverCrash) {
   }
   Image wrong_size(17, 5, PixelFormat::kMono8, 255);
   const ImageView a = white.view(), b = speckle.view(), c = wrong_size.view();
-  proc->process(&a, &a, 0, out);
-  proc->process(&b, &b, 10000000, out);
-  proc->process(&c, &b, 20000000, out);
-  proc->process(&a, &b, 30000000, out);
+  proc->process(std::array<const ImageView*, 2>{&a, &a}, 0, out);
+  proc->process(std::array<const ImageView*, 2>{&b, &b}, 10000000, out);
+  proc->process(std::array<const ImageView*, 2>{&c, &b}, 20000000, out);
+  proc->process(std::array<const ImageView*, 2>{&a, &b}, 30000000, out);
   EXPECT_GT(proc->detector_counters(0).frames_invalid + proc->detector_counters(0).frames_overflow +
                 proc->detector_counters(1).frames_overflow,
             0u);
   // A good frame afterwards is processed exactly as by a fresh processor.
   const ImageView v0 = l.images[0][0].view(), v1 = l.images[0][1].view();
   proc->reset();
-  proc->process(&v0, &v1, 40000000, out);
+  proc->process(std::array<const ImageView*, 2>{&v0, &v1}, 40000000, out);
   auto fresh = FrameProcessor::create(l.rec.rig(), l.targets, nullptr, TrackerConfig{});
   ASSERT_TRUE(fresh.ok());
   FrameOutput ref = fresh->make_output();
-  fresh->process(&v0, &v1, 40000000, ref);
+  fresh->process(std::array<const ImageView*, 2>{&v0, &v1}, 40000000, ref);
   EXPECT_GE(ref.poses.found, 2);
   EXPECT_EQ(out.poses.found, ref.poses.found);
   EXPECT_EQ(out.points.size(), ref.points.size());

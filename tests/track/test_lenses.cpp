@@ -8,6 +8,7 @@
 //  - the partial-marker classification: clean markers flagged partial (must be ~0) and
 //    markers with >= 30 % of their disc hidden in one image flagged partial;
 //  - bodies with >= 3 clean markers: found, and never with a wrong identity.
+#include <array>
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -40,7 +41,7 @@ LensResult run_lens(const test::Lens& lens, int frames, std::uint64_t seed) {
   for (int f = 0; f < scene.frames(); ++f) {
     const auto truth = scene.render(f);
     const ImageView v0 = scene.view(0), v1 = scene.view(1);
-    proc->process(&v0, &v1, scene.timestamp_ns(f), out);
+    proc->process(std::array<const ImageView*, 2>{&v0, &v1}, scene.timestamp_ns(f), out);
 
     std::vector<Vec3> reported, former;
     std::vector<char> used(static_cast<std::size_t>(out.points.size()), 0);

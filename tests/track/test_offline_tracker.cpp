@@ -138,6 +138,69 @@ TEST(OfflineTracker, MarkersCsvLabelsTheMarkersOfEveryPose) {
   EXPECT_GE(markers->size(), 12u * 8u);
 }
 
+TEST(OfflineTracker, FourCamerasAroundTheRobot) {
+  // The simulator's built-in 4-camera arc (docs/simulator.md) on the default limbs
+  // layout, where limbs and marker bases hide markers from some cameras and not others.
+  // Every camera takes part: points.csv has the `cameras` column, points seen by 3 or 4
+  // cameras are refined over all of them, and the figures are the acceptance
+  // targets for 4-camera recordings.
+  sim::SimOptions so;
+  so.cameras = 4;
+  so.frames = 40;
+  so.stray = 3;
+  const std::string& rec = test::simulated_recording("four_cameras", so);
+  test::TempDir out("track_four");
+  OfflineTrackResult r = track_or_fail(rec, out.path(), true);
+  ASSERT_TRUE(r.accuracy.has_value());
+  const AccuracyReport& a = *r.accuracy;
+  std::printf("%s", format_track_summary(r).c_str());
+  ASSERT_GT(a.marker_views, 400);
+  EXPECT_GE(static_cast<double>(a.markers_recalled), 0.99 * static_cast<double>(a.marker_views));
+  EXPECT_LE(a.point_rmse_mm, 0.08);
+  for (const BodyAccuracy& b : a.bodies) {
+    SCOPED_TRACE(b.body);
+    EXPECT_GE(static_cast<double>(b.frames_found), 0.99 * static_cast<double>(b.frames_visible));
+    EXPECT_EQ(b.wrong, 0);
+  }
+  auto points = read_points_csv(out.path() + "/points.csv");
+  ASSERT_TRUE(points.ok()) << points.error().message;
+  int by_views[5] = {};
+  for (const PointRow& p : *points) {
+    ASSERT_GE(p.cameras, 2);
+    ASSERT_LE(p.cameras, 4);
+    ++by_views[p.cameras];
+  }
+  std::printf("points seen by 2/3/4 cameras: %d/%d/%d\n", by_views[2], by_views[3], by_views[4]);
+  EXPECT_GT(by_views[3] + by_views[4], by_views[2]);  // the arc's views overlap
+}
+
+TEST(OfflineTracker, FourCamerasGoOnWithoutAMissingCamera) {
+  // With more than two cameras a frame missing from one camera still yields the points
+  // the others see (at least two present); one camera alone yields none.
+  sim::SimOptions so;
+  so.cameras = 4;
+  so.frames = 40;
+  so.stray = 3;
+  const std::string& src = test::simulated_recording("four_cameras", so);
+  test::TempDir tmp("track_four_missing");
+  const std::string rec = tmp.path() + "/rec";
+  std::filesystem::copy(src, rec, std::filesystem::copy_options::recursive);
+  std::filesystem::remove(frame_file_path(rec, "cam3", 3));
+  for (const char* cam : {"cam0", "cam1", "cam2"}) std::filesystem::remove(frame_file_path(rec, cam, 6));
+  OfflineTrackResult r = track_or_fail(rec, tmp.path() + "/out", false);
+  EXPECT_EQ(r.frames_missing, 2);
+  auto points = read_points_csv(tmp.path() + "/out/points.csv");
+  ASSERT_TRUE(points.ok());
+  int frame3 = 0, frame6 = 0, frame4 = 0;
+  for (const PointRow& p : *points) {
+    frame3 += p.frame == 3 ? 1 : 0;
+    frame4 += p.frame == 4 ? 1 : 0;
+    frame6 += p.frame == 6 ? 1 : 0;
+  }
+  EXPECT_GT(frame3, frame4 / 2);
+  EXPECT_EQ(frame6, 0);
+}
+
 TEST(OfflineTracker, MissingAndDamagedFramesAreDroppedNotFatal) {
   sim::SimOptions so;
   so.frames = 12;
