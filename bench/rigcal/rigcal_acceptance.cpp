@@ -101,7 +101,7 @@ int main(int argc, char** argv) {
   auto truth = load_rig(dir + "/wand/gt/rig_true.yaml");
   auto truth_l = load_rig(dir + "/lframe/gt/rig_lframe_true.yaml");
   if (!truth || !truth_l) return 1;
-  std::array<CameraModel, 2> intr = {truth->cameras[0], truth->cameras[1]};
+  std::vector<CameraModel> intr = {truth->cameras[0], truth->cameras[1]};
   if (intr_mode == "perturbed") {
     intr[0].fx *= 1.004;
     intr[0].fy *= 1.004;
@@ -127,7 +127,7 @@ int main(int argc, char** argv) {
     return 1;
   }
   auto t3 = std::chrono::steady_clock::now();
-  const std::array<CameraModel, 2> cal = res->cameras;  // world = camera 0
+  const std::vector<CameraModel> cal = res->cameras;  // world = camera 0
   // Relative pose errors.
   const Iso3 T10_true = truth->cameras[1].T_cam_world() * truth->cameras[0].T_cam_world().inverse();
   const Iso3 T10_cal = cal[1].T_cam_world() * cal[0].T_cam_world().inverse();

@@ -1,9 +1,10 @@
 // Design: `mocap calibrate-rig [WAND_REC] --wand wand.yaml --out rig.yaml
 // [--intrinsics FILE [--intrinsics FILE]] [--lframe LFRAME_REC] [--report DIR]
 // [--intrinsics-mode auto|refine|fixed] [--min-frames N]`: the wand calibration of
-// src/rigcal (docs/rig_calibration.md). Intrinsics come from the --intrinsics files
-// (rig.yaml, OpenCV FileStorage YAML, ROS camera_info YAML: one file with both
-// cameras or one per camera) or else from the recording's rig.yaml. Without a wand
+// src/rigcal (docs/rig_calibration.md) for the 2 to 8 cameras of the recording's
+// rig.yaml. Intrinsics come from the --intrinsics files (rig.yaml, OpenCV FileStorage
+// YAML, ROS camera_info YAML: one file with all cameras or one per camera) or else
+// from the recording's rig.yaml. Without a wand
 // recording the command only imports: the files must then also give the pair's
 // relative pose (cv::stereoCalibrate's R, T or a ROS left/right pair), and rig.yaml
 // is written from them. Errors are one line on stderr (exit 2); warnings on stderr.
@@ -30,11 +31,15 @@ struct RigArgs {
   int min_frames = 30;
 };
 
-// The two cameras' intrinsics (and maybe relative pose) from the --intrinsics files.
-Expected<ImportedIntrinsics> load_intrinsics(const std::vector<std::string>& files) {
-  if (files.size() > 2)
-    return make_error("calibrate-rig", "--intrinsics", "give one file (both cameras) or two");
-  if (files.size() == 2) {
+// The cameras' intrinsics (and maybe a pair's relative pose) from the --intrinsics
+// files: one file with (at least) all n cameras, or one file per camera.
+Expected<ImportedIntrinsics> load_intrinsics(const std::vector<std::string>& files, std::size_t n) {
+  if (files.size() != 1 && files.size() != n)
+    return make_error("calibrate-rig", "--intrinsics",
+                      n == 2 ? std::string("give one file (both cameras) or two")
+                             : "give one file (all " + std::to_string(n) +
+                                   " cameras) or one per camera (" + std::to_string(n) + ")");
+  if (files.size() == 2 && n == 2) {
     auto a = import_intrinsics(files[0]);
     if (!a) return a.error();
     auto b = import_intrinsics(files[1]);
@@ -55,19 +60,34 @@ Expected<ImportedIntrinsics> load_intrinsics(const std::vector<std::string>& fil
     }
     return out;
   }
+  if (files.size() > 1) {
+    ImportedIntrinsics out;
+    for (const std::string& file : files) {
+      auto one = import_intrinsics(file);
+      if (!one) return one.error();
+      if (one->cameras.size() != 1)
+        return make_error(file, "cameras",
+                          "with one --intrinsics file per camera, each must describe one camera");
+      out.cameras.push_back(one->cameras[0]);
+    }
+    return out;
+  }
   auto a = import_intrinsics(files[0]);
   if (!a) return a.error();
-  if (a->cameras.size() < 2)
+  if (a->cameras.size() < n)
     return make_error(files[0], "cameras",
-                      "describes one camera: give a second --intrinsics file for camera 1");
-  a->cameras.resize(2);
+                      n == 2 ? std::string("describes one camera: give a second --intrinsics "
+                                           "file for camera 1")
+                             : "describes " + std::to_string(a->cameras.size()) +
+                                   " cameras, the recording has " + std::to_string(n));
+  a->cameras.resize(n);
   return a;
 }
 
 int import_only(const RigArgs& a) {
   if (a.intrinsics.empty())
     return fail("calibrate-rig: give a wand recording, or --intrinsics files to import");
-  auto imp = load_intrinsics(a.intrinsics);
+  auto imp = load_intrinsics(a.intrinsics, 2);
   if (!imp) return fail(imp.error().message);
   if (!imp->has_relative_pose)
     return fail(a.intrinsics[0] +
@@ -112,13 +132,13 @@ int run(const RigArgs& a) {
                 ": lframe: missing: --lframe needs the L-frame's markers in the wand file");
   auto rec = Recording::open(a.recording);
   if (!rec) return fail(rec.error().message);
-  if (rec->rig().cameras.size() < 2)
-    return fail(a.recording + "/rig.yaml: cameras: a stereo recording needs two cameras");
-  std::array<CameraModel, 2> intr = {rec->rig().cameras[0], rec->rig().cameras[1]};
+  const std::size_t ncams = rec->rig().cameras.size();
+  if (auto v = rigcal::check_camera_count(ncams, a.recording); !v) return fail(v.error().message);
+  std::vector<CameraModel> intr = rec->rig().cameras;
   if (!a.intrinsics.empty()) {
-    auto imp = load_intrinsics(a.intrinsics);
+    auto imp = load_intrinsics(a.intrinsics, ncams);
     if (!imp) return fail(imp.error().message);
-    for (std::size_t c = 0; c < 2; ++c) {
+    for (std::size_t c = 0; c < ncams; ++c) {
       CameraModel m = imp->cameras[c];
       const CameraModel& r = rec->rig().cameras[c];
       if (m.width == 0 && m.height == 0) {
@@ -145,7 +165,7 @@ int run(const RigArgs& a) {
       return fail(r.error().message);
   }
   Rig rig;
-  rig.cameras = {result->cameras[0], result->cameras[1]};
+  rig.cameras = result->cameras;
   if (auto r = save_rig(a.out, rig); !r) return fail(r.error().message);
   std::string report = a.report;
   if (report.empty()) {
@@ -155,11 +175,16 @@ int run(const RigArgs& a) {
   if (auto r = rigcal::write_report(report, *result, opt); !r) return fail(r.error().message);
   for (const std::string& w : result->warnings)
     std::fprintf(stderr, "mocap: warning: %s\n", w.c_str());
+  std::string rms;
+  for (const rigcal::CameraQuality& q : result->quality) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%s%.3f", rms.empty() ? "" : " / ", q.reprojection_rms_px);
+    rms += buf;
+  }
   std::printf(
-      "calibrate-rig: %d of %d frames used, baseline %.3f mm, reprojection RMS %.3f / "
-      "%.3f px, wand length error mean %.4f mm RMS %.4f mm%s -> %s (report in %s)\n",
-      result->frames_used, result->frames_total, result->baseline_mm,
-      result->quality[0].reprojection_rms_px, result->quality[1].reprojection_rms_px,
+      "calibrate-rig: %d of %d frames used, baseline %.3f mm, reprojection RMS %s px, wand "
+      "length error mean %.4f mm RMS %.4f mm%s -> %s (report in %s)\n",
+      result->frames_used, result->frames_total, result->baseline_mm, rms.c_str(),
       result->wand_length_mean_error_mm, result->wand_length_rms_error_mm,
       result->has_ground ? ", ground frame set" : "", a.out.c_str(), report.c_str());
   std::printf("calibrate-rig: %s\n", result->intrinsics_note.c_str());
@@ -168,23 +193,24 @@ int run(const RigArgs& a) {
 
 void register_calibrate_rig(CLI::App& app, int& exit_code) {
   auto args = std::make_shared<RigArgs>();
-  CLI::App* cmd =
-      app.add_subcommand("calibrate-rig",
-                         "Calibrate the stereo rig from a wand recording (and an L-frame), or "
-                         "import intrinsics into rig.yaml");
+  CLI::App* cmd = app.add_subcommand(
+      "calibrate-rig",
+      "Calibrate the camera rig (2 to 8 cameras) from a wand recording (and an L-frame), or "
+      "import intrinsics into rig.yaml");
   cmd->add_option("recording", args->recording, "Wand recording folder");
   cmd->add_option("--wand", args->wand, "Wand (and L-frame) description, wand.yaml");
   cmd->add_option("--out", args->out, "Output rig.yaml")->required();
   cmd->add_option("--intrinsics", args->intrinsics,
-                  "rig.yaml, OpenCV FileStorage YAML or ROS camera_info YAML (once for both "
-                  "cameras, or twice: camera 0 then camera 1); default: the recording's rig.yaml");
+                  "rig.yaml, OpenCV FileStorage YAML or ROS camera_info YAML (once for all "
+                  "cameras, or once per camera in rig.yaml's order); default: the recording's "
+                  "rig.yaml");
   cmd->add_option("--lframe", args->lframe, "L-frame recording folder: sets the world frame");
   cmd->add_option("--report", args->report,
                   "Folder of report.yaml and the coverage PNGs (default: <out>_report)");
   cmd->add_option("--intrinsics-mode", args->mode,
                   "auto (refine when the wand covered the images well), refine or fixed");
   cmd->add_option("--min-frames", args->min_frames,
-                  "Fewest frames with the wand in both cameras (default 30)");
+                  "Fewest frames with the wand in two or more cameras (default 30)");
   cmd->callback([args, &exit_code] { exit_code = run(*args); });
 }
 

@@ -6,6 +6,7 @@
 #include <ceres/rotation.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 namespace mocap::rigcal {
@@ -74,30 +75,57 @@ void set_pose(CameraModel& c, const std::array<double, 6>& p) {
 
 }  // namespace
 
-bool wand_residuals(const std::array<CameraModel, 2>& cams, const WandSpec& wand,
-                    const WandFrame& obs, const WandPose& pose, std::vector<double>& err_px) {
+int WandFrame::cameras_labelled() const noexcept {
+  int n = 0;
+  for (const auto& p : px) n += p.empty() ? 0 : 1;
+  return n;
+}
+
+bool wand_residuals(const std::vector<CameraModel>& cams, const WandSpec& wand,
+                    const WandFrame& obs, const WandPose& pose, std::vector<double>& err_px,
+                    std::vector<int>* camera) {
   err_px.clear();
-  for (std::size_t c = 0; c < 2; ++c) {
+  if (camera) camera->clear();
+  for (std::size_t c = 0; c < cams.size() && c < obs.px.size(); ++c) {
+    if (obs.px[c].empty()) continue;
     for (std::size_t k = 0; k < wand.markers_mm.size(); ++k) {
       const Vec3 X = pose.A + (wand.markers_mm[k] - wand.markers_mm[0]) * pose.d;
       Vec2 px;
       if (!project(cams[c], X, px)) return false;
       err_px.push_back((px - obs.px[c][k]).norm());
+      if (camera) camera->push_back(static_cast<int>(c));
     }
   }
   return true;
 }
 
 Expected<BundleStats> bundle_adjust(const WandSpec& wand, const std::vector<WandFrame>& frames,
-                                    std::vector<bool>& use, std::array<CameraModel, 2>& cams,
+                                    std::vector<bool>& use, std::vector<CameraModel>& cams,
                                     std::vector<WandPose>& poses, const BundleOptions& options) {
   if (frames.size() != poses.size() || frames.size() != use.size())
     return make_error("bundle", "", "frames, poses and flags differ in size");
+  const std::size_t C = cams.size();
+  if (C < 2) return make_error("bundle", "cameras", "needs at least two cameras");
+  if (!options.refine_camera.empty() && options.refine_camera.size() != C)
+    return make_error("bundle", "refine_camera", "one flag per camera expected");
+  for (std::size_t f = 0; f < frames.size(); ++f) {
+    if (frames[f].px.size() != C)
+      return make_error("bundle", "frame " + std::to_string(frames[f].frame),
+                        "observations of " + std::to_string(frames[f].px.size()) +
+                            " cameras, the rig has " + std::to_string(C));
+    if (frames[f].cameras_labelled() < 2) use[f] = false;
+  }
   BundleStats stats;
   std::vector<double> err;
+  std::vector<int> err_cam;
   for (int round = 0; round < std::max(1, options.rounds); ++round) {
-    std::array<std::array<double, 9>, 2> intr = {intrinsics_of(cams[0]), intrinsics_of(cams[1])};
-    std::array<std::array<double, 6>, 2> pose = {std::array<double, 6>{}, pose_of(cams[1])};
+    std::vector<std::array<double, 9>> intr(C);
+    std::vector<std::array<double, 6>> pose(C);
+    for (std::size_t c = 0; c < C; ++c) {
+      intr[c] = intrinsics_of(cams[c]);
+      pose[c] = c == 0 ? std::array<double, 6>{} : pose_of(cams[c]);
+    }
+    std::vector<bool> observed(C, false);
     std::vector<std::array<double, 6>> W(frames.size());
     ceres::Problem problem;
     auto* loss = new ceres::HuberLoss(options.huber_px);
@@ -108,7 +136,9 @@ Expected<BundleStats> bundle_adjust(const WandSpec& wand, const std::vector<Wand
       ++used;
       const Vec3 dn = poses[f].d.normalized();
       W[f] = {poses[f].A.x(), poses[f].A.y(), poses[f].A.z(), dn.x(), dn.y(), dn.z()};
-      for (std::size_t c = 0; c < 2; ++c) {
+      for (std::size_t c = 0; c < C; ++c) {
+        if (frames[f].px[c].empty()) continue;
+        observed[c] = true;
         for (std::size_t k = 0; k < wand.markers_mm.size(); ++k) {
           auto* cost = new ceres::AutoDiffCostFunction<WandReprojection, 2, 9, 6, 6>(
               new WandReprojection{frames[f].px[c][k], wand.markers_mm[k] - wand.markers_mm[0]});
@@ -126,9 +156,18 @@ Expected<BundleStats> bundle_adjust(const WandSpec& wand, const std::vector<Wand
       return make_error("bundle", "",
                         "only " + std::to_string(used) + " usable wand frames (need at least 8)");
     }
-    problem.SetParameterBlockConstant(pose[0].data());
-    for (std::size_t c = 0; c < 2; ++c) {
-      if (options.refine_intrinsics) {
+    for (std::size_t c = 1; c < C; ++c) {
+      if (!observed[c]) {
+        delete ordering;
+        return make_error("bundle", cams[c].name, "no usable wand frame sees this camera");
+      }
+    }
+    for (std::size_t c = 0; c < C; ++c) {
+      if (!observed[c]) continue;  // camera 0 only: the gauge needs no residual
+      if (c == 0) problem.SetParameterBlockConstant(pose[c].data());
+      const bool refine =
+          options.refine_camera.empty() ? options.refine_intrinsics : options.refine_camera[c];
+      if (refine) {
         problem.SetManifold(intr[c].data(), new ceres::SubsetManifold(9, {6, 7, 8}));
       } else {
         problem.SetParameterBlockConstant(intr[c].data());
@@ -151,9 +190,9 @@ Expected<BundleStats> bundle_adjust(const WandSpec& wand, const std::vector<Wand
     stats.converged = summary.termination_type == ceres::CONVERGENCE;
     if (!summary.IsSolutionUsable())
       return make_error("bundle", "", "Ceres failed: " + summary.message);
-    for (std::size_t c = 0; c < 2; ++c) {
+    for (std::size_t c = 0; c < C; ++c) {
       set_intrinsics(cams[c], intr[c]);
-      if (c == 1) set_pose(cams[c], pose[c]);
+      if (c > 0) set_pose(cams[c], pose[c]);
     }
     for (std::size_t f = 0; f < frames.size(); ++f) {
       if (!use[f]) continue;
@@ -189,8 +228,9 @@ Expected<BundleStats> bundle_adjust(const WandSpec& wand, const std::vector<Wand
     }
   }
   // Statistics over the frames in use.
-  std::array<double, 2> sum{};
-  std::array<int, 2> count{};
+  std::vector<double> sum(C, 0.0);
+  std::vector<int> count(C, 0);
+  stats.frames_per_camera.assign(C, 0);
   stats.frames_used = 0;
   for (std::size_t f = 0; f < frames.size(); ++f) {
     if (!use[f]) {
@@ -198,14 +238,17 @@ Expected<BundleStats> bundle_adjust(const WandSpec& wand, const std::vector<Wand
       continue;
     }
     ++stats.frames_used;
-    if (!wand_residuals(cams, wand, frames[f], poses[f], err)) continue;
-    const std::size_t N = wand.markers_mm.size();
+    for (std::size_t c = 0; c < C; ++c)
+      stats.frames_per_camera[c] += frames[f].px[c].empty() ? 0 : 1;
+    if (!wand_residuals(cams, wand, frames[f], poses[f], err, &err_cam)) continue;
     for (std::size_t i = 0; i < err.size(); ++i) {
-      sum[i / N] += err[i] * err[i];
-      ++count[i / N];
+      const auto c = static_cast<std::size_t>(err_cam[i]);
+      sum[c] += err[i] * err[i];
+      ++count[c];
     }
   }
-  for (std::size_t c = 0; c < 2; ++c)
+  stats.rms_px.assign(C, 0.0);
+  for (std::size_t c = 0; c < C; ++c)
     stats.rms_px[c] = count[c] > 0 ? std::sqrt(sum[c] / count[c]) : 0.0;
   return stats;
 }

@@ -1,17 +1,19 @@
-// Design: bundle adjustment of the stereo rig from wand observations (Ceres). The world
-// is camera 0's frame (its pose is held constant: the gauge); camera 1's pose is an
-// angle-axis rotation plus a translation. Each wand frame is the position A of marker 0
+// Design: bundle adjustment of a rig of 2..8 cameras from wand observations (Ceres), one
+// joint problem over all cameras. The world is camera 0's frame (its pose is held
+// constant: the gauge); every other camera's pose is an angle-axis rotation plus a
+// translation. Each wand frame is the position A of marker 0
 // and a unit direction d (SphereManifold), so marker k sits exactly at A + s_k d: the
 // wand's length fixes the metric scale and collinearity is built in. Residuals are the
 // reprojection errors in the real (distorted) images through the same model as
 // camera_model.h (OpenCV's 5-parameter distortion), with a Huber loss. Intrinsics
 // [fx fy cx cy k1 k2 p1 p2 k3] are constant unless refine_intrinsics; then fx, fy, cx,
-// cy, k1, k2 are estimated and p1, p2, k3 stay as given (weakly observable from a wand).
+// cy, k1, k2 are estimated and p1, p2, k3 stay as given (weakly observable from a wand);
+// this is decided per camera (refine_camera). A frame takes part when the wand is
+// labelled in at least two cameras; a camera where it is not labelled adds no residual.
 // Frames with a residual far above the RMS are dropped and the problem solved again.
 // Linear solver: dense Schur complement with the wand poses eliminated first.
 #pragma once
 
-#include <array>
 #include <vector>
 
 #include "camera/camera_model.h"
@@ -20,10 +22,16 @@
 
 namespace mocap::rigcal {
 
-// One frame with the wand labelled in both cameras (distorted pixels, marker order).
+// Blob centres (distorted pixels) per frame and camera: blobs[f][c], every frame with
+// one entry per camera of the rig.
+using FrameBlobs = std::vector<std::vector<std::vector<Vec2>>>;
+
+// One frame of the wand (distorted pixels, marker order). px has one entry per camera;
+// an empty entry: the wand is not labelled in that camera.
 struct WandFrame {
   int frame = 0;
-  std::array<std::vector<Vec2>, 2> px;
+  std::vector<std::vector<Vec2>> px;
+  int cameras_labelled() const noexcept;
 };
 
 // Wand pose in camera 0's frame: marker k at A + (s_k - s_0) d.
@@ -34,6 +42,8 @@ struct WandPose {
 
 struct BundleOptions {
   bool refine_intrinsics = false;
+  // Per camera; empty: every camera as refine_intrinsics says.
+  std::vector<bool> refine_camera;
   double huber_px = 1.0;
   // Frames with a marker residual above clamp(outlier_sigmas x RMS, outlier_min_px,
   // outlier_px) after a round are dropped.
@@ -45,22 +55,26 @@ struct BundleOptions {
 };
 
 struct BundleStats {
-  std::array<double, 2> rms_px{};  // reprojection RMS per camera over used frames
+  std::vector<double> rms_px;          // reprojection RMS per camera over used frames
+  std::vector<int> frames_per_camera;  // used frames labelled in each camera
   int frames_used = 0;
   int frames_dropped = 0;
   int iterations = 0;
   bool converged = false;
 };
 
-// Reprojection error vectors of one frame (2 cameras x N markers); false if behind.
-bool wand_residuals(const std::array<CameraModel, 2>& cams, const WandSpec& wand,
-                    const WandFrame& obs, const WandPose& pose, std::vector<double>& err_px);
+// Reprojection errors (px) of one frame, labelled cameras in order x N markers; camera
+// (optional) receives each error's camera index. False if a point is behind a camera.
+bool wand_residuals(const std::vector<CameraModel>& cams, const WandSpec& wand,
+                    const WandFrame& obs, const WandPose& pose, std::vector<double>& err_px,
+                    std::vector<int>* camera = nullptr);
 
 // cams: initial values in, estimates out (cams[0] must be at the identity pose).
 // poses: one per frame, initial values in, estimates out. use: which frames take part
-// (updated: outliers set false).
+// (updated: outliers and frames labelled in fewer than two cameras set false). Every
+// frame's px must have cams.size() entries.
 Expected<BundleStats> bundle_adjust(const WandSpec& wand, const std::vector<WandFrame>& frames,
-                                    std::vector<bool>& use, std::array<CameraModel, 2>& cams,
+                                    std::vector<bool>& use, std::vector<CameraModel>& cams,
                                     std::vector<WandPose>& poses, const BundleOptions& options);
 
 }  // namespace mocap::rigcal

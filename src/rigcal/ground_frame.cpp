@@ -10,7 +10,7 @@
 
 namespace mocap::rigcal {
 
-void apply_ground_frame(std::array<CameraModel, 2>& cams, const Iso3& T_cam0_lframe) {
+void apply_ground_frame(std::vector<CameraModel>& cams, const Iso3& T_cam0_lframe) {
   for (CameraModel& c : cams) {
     const Iso3 T = c.T_cam_world() * T_cam0_lframe;
     c.R_cam_world = T.linear();
@@ -18,55 +18,80 @@ void apply_ground_frame(std::array<CameraModel, 2>& cams, const Iso3& T_cam0_lfr
   }
 }
 
-Expected<GroundFrameResult> estimate_ground_frame(
-    const LFrameSpec& lframe, const std::vector<std::array<std::vector<Vec2>, 2>>& blobs,
-    const std::array<CameraModel, 2>& cams, const GroundFrameOptions& opt,
-    const std::string& source) {
-  auto g = make_stereo_geometry(cams[0], cams[1]);
-  if (!g) return g.error();
+Expected<GroundFrameResult> estimate_ground_frame(const LFrameSpec& lframe, const FrameBlobs& blobs,
+                                                  const std::vector<CameraModel>& cams,
+                                                  const GroundFrameOptions& opt,
+                                                  const std::string& source) {
+  const std::size_t C = cams.size();
+  std::vector<StereoGeometry> pair_geometry;  // pairs (a < b) in lexicographic order
+  for (std::size_t a = 0; a < C; ++a) {
+    for (std::size_t b = a + 1; b < C; ++b) {
+      auto g = make_stereo_geometry(cams[a], cams[b]);
+      if (!g) return g.error();
+      pair_geometry.push_back(*g);
+    }
+  }
   struct Cluster {
     Vec3 sum = Vec3::Zero();
-    int count = 0;
+    int count = 0;   // points
+    int frames = 0;  // frames that added a point
+    int last_frame = -1;
     Vec3 mean() const { return sum / count; }
   };
   std::vector<Cluster> clusters;
   int frames = 0;
-  for (const auto& fb : blobs) {
-    std::vector<Vec2> s0, s1;
-    std::vector<Vec2> n0, n1;
-    for (const Vec2& p : fb[0]) {
-      Vec2 xn;
-      if (undistort_pixel(cams[0], p, xn)) {
-        n0.push_back(xn);
-        s0.push_back(to_scaled(cams[0], xn));
+  std::vector<std::vector<Vec2>> s(C), n(C);  // per camera: pixel-scaled, normalised
+  for (std::size_t f = 0; f < blobs.size(); ++f) {
+    const auto& fb = blobs[f];
+    if (fb.size() != C)
+      return make_error(
+          source, "frame " + std::to_string(f),
+          "blobs of " + std::to_string(fb.size()) + " cameras, the rig has " + std::to_string(C));
+    int seen = 0;
+    for (std::size_t c = 0; c < C; ++c) {
+      s[c].clear();
+      n[c].clear();
+      for (const Vec2& p : fb[c]) {
+        Vec2 xn;
+        if (undistort_pixel(cams[c], p, xn)) {
+          n[c].push_back(xn);
+          s[c].push_back(to_scaled(cams[c], xn));
+        }
       }
+      seen += n[c].empty() ? 0 : 1;
     }
-    for (const Vec2& p : fb[1]) {
-      Vec2 xn;
-      if (undistort_pixel(cams[1], p, xn)) {
-        n1.push_back(xn);
-        s1.push_back(to_scaled(cams[1], xn));
-      }
-    }
-    if (n0.empty() || n1.empty()) continue;
+    if (seen < 2) continue;
     ++frames;
-    for (std::size_t i = 0; i < n0.size(); ++i) {
-      for (std::size_t j = 0; j < n1.size(); ++j) {
-        double d0 = 0.0, d1 = 0.0;
-        epipolar_distances_px(*g, s0[i], s1[j], d0, d1);
-        if (std::max(d0, d1) > opt.max_epipolar_px) continue;
-        Vec3 X;
-        if (!triangulate_niter2(*g, n0[i], n1[j], X)) continue;
-        bool joined = false;
-        for (Cluster& c : clusters) {
-          if ((c.mean() - X).norm() < opt.cluster_radius_mm) {
-            c.sum += X;
-            ++c.count;
-            joined = true;
-            break;
+    std::size_t pair = 0;
+    for (std::size_t a = 0; a < C; ++a) {
+      for (std::size_t b = a + 1; b < C; ++b, ++pair) {
+        const StereoGeometry& g = pair_geometry[pair];
+        for (std::size_t i = 0; i < n[a].size(); ++i) {
+          for (std::size_t j = 0; j < n[b].size(); ++j) {
+            double d0 = 0.0, d1 = 0.0;
+            epipolar_distances_px(g, s[a][i], s[b][j], d0, d1);
+            if (std::max(d0, d1) > opt.max_epipolar_px) continue;
+            Vec3 X;
+            if (!triangulate_niter2(g, n[a][i], n[b][j], X)) continue;
+            Cluster* hit = nullptr;
+            for (Cluster& c : clusters) {
+              if ((c.mean() - X).norm() < opt.cluster_radius_mm) {
+                hit = &c;
+                break;
+              }
+            }
+            if (!hit) {
+              clusters.push_back(Cluster{});
+              hit = &clusters.back();
+            }
+            hit->sum += X;
+            ++hit->count;
+            if (hit->last_frame != static_cast<int>(f)) {
+              hit->last_frame = static_cast<int>(f);
+              ++hit->frames;
+            }
           }
         }
-        if (!joined) clusters.push_back(Cluster{X, 1});
       }
     }
   }
@@ -75,7 +100,7 @@ Expected<GroundFrameResult> estimate_ground_frame(
   std::sort(clusters.begin(), clusters.end(),
             [](const Cluster& a, const Cluster& b) { return a.count > b.count; });
   for (const Cluster& c : clusters) {
-    if (c.count * 2 >= frames && pts.size() < M + 4) pts.push_back(c.mean());
+    if (c.frames * 2 >= frames && pts.size() < M + 4) pts.push_back(c.mean());
   }
   if (frames == 0 || pts.size() < M) {
     return make_error(source, "lframe",

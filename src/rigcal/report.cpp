@@ -1,6 +1,7 @@
 // Design: see report.h.
 #include "rigcal/report.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
@@ -29,6 +30,7 @@ std::string quoted(const std::string& s) {
 std::string format_report_yaml(const RigCalResult& r, const RigCalOptions& opt) {
   std::string s = "# mocap calibrate-rig quality report (docs/rig_calibration.md)\n";
   s += "frames_total: " + std::to_string(r.frames_total) + "\n";
+  s += "camera_count: " + std::to_string(r.cameras.size()) + "\n";
   s += "frames_wand_in_both: " + std::to_string(r.frames_both) + "\n";
   s += "frames_used: " + std::to_string(r.frames_used) + "\n";
   s += "essential_inliers: " + std::to_string(r.essential_inliers) + "\n";
@@ -53,6 +55,21 @@ std::string format_report_yaml(const RigCalResult& r, const RigCalOptions& opt) 
     s += "    coverage: " + num(q.coverage, 3) + "   # occupied cells of a " +
          std::to_string(opt.coverage_cols) + "x" + std::to_string(opt.coverage_rows) + " grid\n";
     s += "    coverage_png: " + quoted("coverage_" + q.name + ".png") + "\n";
+    // Added for rigs of more than two cameras (present for every rig).
+    s += "    frames_used: " + std::to_string(q.frames_used) + "\n";
+    s += "    intrinsics_refined: " + std::string(q.intrinsics_refined ? "true" : "false") + "\n";
+    s += "    initialised_from: " + quoted(q.initialised_from) + "\n";
+    s += "    essential_inliers: " + std::to_string(q.essential_inliers) + "\n";
+    const Mat3 R = q.T_cam_cam0.linear();
+    const Vec3 t = q.T_cam_cam0.translation();
+    s += "    baseline_mm: " + num(q.baseline_mm, 4) + "   # centre's distance from camera 0\n";
+    s += "    rotation_from_cam0_deg: " +
+         num(Eigen::AngleAxisd(R).angle() * 180.0 / 3.14159265358979323846, 4) + "\n";
+    s += "    R_cam_cam0: [";
+    for (int i = 0; i < 9; ++i) s += (i ? ", " : "") + num(R(i / 3, i % 3), 9);
+    s += "]   # X_cam = R X_cam0 + t\n";
+    s += "    t_cam_cam0_mm: [" + num(t.x(), 4) + ", " + num(t.y(), 4) + ", " + num(t.z(), 4) +
+         "]\n";
   }
   if (r.has_ground) {
     s += "ground_frame: {rms_mm: " + num(r.ground.rms_mm, 4) +
@@ -101,7 +118,7 @@ Expected<void> write_report(const std::string& dir, const RigCalResult& r,
   const std::string text = format_report_yaml(r, opt);
   const bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
   if (std::fclose(f) != 0 || !ok) return make_error(path, "", "cannot write: I/O error");
-  for (std::size_t c = 0; c < 2; ++c) {
+  for (std::size_t c = 0; c < r.quality.size() && c < r.cameras.size(); ++c) {
     auto w =
         write_png(dir + "/coverage_" + r.quality[c].name + ".png",
                   coverage_image(r.quality[c], r.cameras[c], opt.coverage_cols, opt.coverage_rows));

@@ -1,23 +1,25 @@
-// Design: the wand calibration of a stereo rig, end to end (`mocap calibrate-rig`):
+// Design: the wand calibration of a rig of 2..8 cameras (kMinRigCameras..kMaxRigCameras),
+// end to end (`mocap calibrate-rig`):
 //  1. detect blobs in every frame of the wand recording (BlobDetector; merged, split
-//     and border blobs are dropped) and label the wand per image (wand_labeler.h);
-//  2. initial relative pose: RANSAC essential matrix on the undistorted normalised wand
-//     points of the frames labelled in both cameras (essential.h);
-//  3. metric scale: the median triangulated end-to-end length against the wand's
-//     length; the inner markers' measured positions are checked against wand.yaml
-//     (a wrong spacing is an error, not a silently distorted rig);
-//  4. bundle adjustment (bundle.h) of camera 1's pose and every wand pose, then, when
-//     the wand covered both images well and enough frames were used (or when asked),
-//     of the intrinsics and distortion too;
-//  5. quality: reprojection RMS per camera, wand-length error of independently
-//     triangulated ends (mean, RMS), image coverage (occupied cells of a grid);
-//     warnings for too little coverage or too few frames;
+//     and border blobs are dropped) and label the wand per image (wand_labeler.h); a
+//     frame takes part when the wand is labelled in at least two cameras;
+//  2.-3. initial rig, pairwise from camera 0 (pairwise_init.h): per camera a RANSAC
+//     essential matrix with camera 0 (or, with too few shared frames, with the
+//     best-connected initialised camera), metric scale from the wand length, the inner
+//     markers' spacing checked against wand.yaml;
+//  4. one joint bundle adjustment (bundle.h) of every camera's pose but camera 0's and
+//     every wand pose, then, for each camera that the wand covered well in enough
+//     frames (or when asked), of its intrinsics and distortion too;
+//  5. quality: per camera reprojection RMS, frames, coverage, label statuses and pose
+//     relative to camera 0; wand-length error of independently triangulated ends
+//     (mean, RMS); warnings for too little coverage or too few frames;
 //  6. optionally the ground frame from an L-frame recording (ground_frame.h).
 // The result's world is camera 0's frame, or the L-frame's when one was given.
 // Setup-time code: allocates, returns one-line errors.
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -32,6 +34,9 @@
 
 namespace mocap::rigcal {
 
+inline constexpr std::size_t kMinRigCameras = 2;
+inline constexpr std::size_t kMaxRigCameras = 8;
+
 enum class IntrinsicsMode { kAuto, kRefine, kFixed };
 
 struct RigCalOptions {
@@ -39,20 +44,18 @@ struct RigCalOptions {
   double min_roundness = 0.95;  // of the expected roundness (detect_recording)
   WandLabelConfig label{};
   IntrinsicsMode intrinsics = IntrinsicsMode::kAuto;
-  int min_frames = 30;            // fewer frames with the wand in both cameras: error
+  int min_frames = 30;            // fewer frames with the wand in >= 2 cameras: error; also the
+                                  // fewest frames a camera shares with its initialisation partner
   int warn_frames = 200;          // fewer: warning
   double warn_coverage = 0.5;     // occupied fraction of the coverage grid below: warning
-  double refine_coverage = 0.75;  // kAuto refines intrinsics only above this (both cameras)
-  int refine_min_frames = 200;    // ... and with at least this many frames used
+  double refine_coverage = 0.75;  // kAuto refines a camera's intrinsics only above this
+  int refine_min_frames = 200;    // ... and with at least this many used frames in it
   int coverage_cols = 16;
   int coverage_rows = 12;
   double max_spacing_error = 0.02;  // measured inner-marker fraction vs wand.yaml
   std::uint64_t seed = 1;           // RANSAC
   GroundFrameOptions ground{};
 };
-
-// Blob centres (distorted pixels) per frame and camera.
-using FrameBlobs = std::vector<std::array<std::vector<Vec2>, 2>>;
 
 struct CameraQuality {
   std::string name;
@@ -61,16 +64,22 @@ struct CameraQuality {
   double reprojection_rms_px = 0.0;
   double coverage = 0.0;             // occupied fraction of the grid
   std::vector<Vec2> wand_points_px;  // every labelled wand marker (for the coverage image)
+  int frames_used = 0;               // bundle frames with the wand labelled in this camera
+  bool intrinsics_refined = false;
+  std::string initialised_from;        // the reference camera of its initial pose ("" for cam 0)
+  int essential_inliers = 0;           // of that pair's RANSAC
+  Iso3 T_cam_cam0 = Iso3::Identity();  // pose relative to camera 0: X_cam = T X_cam0
+  double baseline_mm = 0.0;            // distance of its centre from camera 0's
 };
 
 struct RigCalResult {
-  std::array<CameraModel, 2> cameras;  // world = camera 0 or the L-frame
-  std::array<CameraQuality, 2> quality;
+  std::vector<CameraModel> cameras;  // world = camera 0 or the L-frame
+  std::vector<CameraQuality> quality;
   int frames_total = 0;
-  int frames_both = 0;  // wand labelled in both cameras
-  int frames_used = 0;  // after the bundle adjustment's outlier rejection
-  int essential_inliers = 0;
-  double baseline_mm = 0.0;
+  int frames_both = 0;        // wand labelled in at least two cameras (both, for a pair)
+  int frames_used = 0;        // after the bundle adjustment's outlier rejection
+  int essential_inliers = 0;  // summed over the initialisation pairs
+  double baseline_mm = 0.0;   // camera 1's distance from camera 0
   double wand_length_mean_error_mm = 0.0;
   double wand_length_rms_error_mm = 0.0;
   int wand_length_samples = 0;
@@ -82,7 +91,12 @@ struct RigCalResult {
   std::vector<std::string> warnings;
 };
 
-// Detects blobs in every frame of a recording (cameras 0 and 1). Blobs that are merged,
+// A rig calibration needs kMinRigCameras..kMaxRigCameras cameras; else the one-line
+// error "<recording>/rig.yaml: cameras: ...".
+Expected<void> check_camera_count(std::size_t cameras, const std::string& recording);
+
+// Detects blobs in every frame of a recording (every camera of its rig.yaml: 2..8, else
+// a one-line error naming the rig.yaml). Blobs that are merged,
 // split or touch the border are left out, and so are blobs less round than
 // min_roundness x the roundness a whole ball has at that place in the image (a ball's
 // image is an ellipse stretched radially by perspective and squeezed by barrel
@@ -90,18 +104,19 @@ struct RigCalResult {
 // cams: the intrinsics for that expectation (the recording's rig.yaml when null).
 Expected<FrameBlobs> detect_recording(const std::string& dir, const detect::DetectorConfig& cfg,
                                       double min_roundness = 0.0,
-                                      const std::array<CameraModel, 2>* cams = nullptr);
+                                      const std::vector<CameraModel>* cams = nullptr);
 
 // Minor/major axis ratio of a small ball's image centred at pixel px (first order:
 // perspective stretch 1/cos(off-axis angle) and the distortion's radial/tangential
 // scales).
 double expected_roundness(const CameraModel& cam, const Vec2& px) noexcept;
 
-// The calibration from already detected blobs. intrinsics: the two cameras' intrinsics
-// (names and sizes must be set; extrinsics ignored). source names the recording in
-// errors.
+// The calibration from already detected blobs. intrinsics: the cameras' intrinsics
+// (2..8; names and sizes must be set; extrinsics ignored), blobs with one entry per
+// camera. source names the recording in errors (a wrong camera count names
+// source/rig.yaml).
 Expected<RigCalResult> calibrate_from_blobs(const FrameBlobs& blobs, const WandSpec& wand,
-                                            const std::array<CameraModel, 2>& intrinsics,
+                                            const std::vector<CameraModel>& intrinsics,
                                             const RigCalOptions& options,
                                             const std::string& source);
 

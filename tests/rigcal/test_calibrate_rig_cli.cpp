@@ -1,6 +1,7 @@
 // Design: `mocap calibrate-rig` end to end: importing an OpenCV stereo calibration into
 // rig.yaml, and the one-line errors with exit code 2 (import without R/T, a missing
-// wand file, a bad option, and too few wand frames in a small drawn recording).
+// wand file, a bad option, too few wand frames in a small drawn recording, a
+// recording of 9 cameras).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -94,6 +95,29 @@ TEST(CalibrateRigCli, Errors) {
       << r.output;
   EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
   EXPECT_FALSE(std::filesystem::exists(dir.file("rig.yaml")));
+}
+
+TEST(CalibrateRigCli, NineCameraRecordingIsAnError) {
+  test::TempDir dir("rigcli");
+  const auto scene = sim::make_scene(sim::SimOptions{});
+  ASSERT_TRUE(scene);
+  Rig rig;
+  for (int c = 0; c < 9; ++c) {
+    rig.cameras.push_back(scene->rig.cameras[0]);
+    rig.cameras.back().name = "cam" + std::to_string(c);
+    std::filesystem::create_directories(dir.file("w/cam" + std::to_string(c)));
+  }
+  ASSERT_TRUE(save_rig(dir.file("w/rig.yaml"), rig));
+  ASSERT_TRUE(save_frames_csv(dir.file("w/frames.csv"), {FrameEntry{0, 0}}));
+  ASSERT_TRUE(save_calibration_objects(dir.file("wand.yaml"), sim::default_calibration_objects()));
+  auto r = test::run_mocap("calibrate-rig " + dir.file("w") + " --wand " + dir.file("wand.yaml") +
+                           " --out " + dir.file("rig.yaml"));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find(dir.file("w") +
+                          "/rig.yaml: cameras: 9 cameras listed, a rig calibration takes 2 to 8"),
+            std::string::npos)
+      << r.output;
+  EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
 }
 
 }  // namespace

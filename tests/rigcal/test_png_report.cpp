@@ -60,6 +60,8 @@ TEST(Png, ChunksAndPixelsRoundTrip) {
 TEST(Report, YamlAndCoverageFiles) {
   RigCalResult r;
   r.frames_total = 10;
+  r.cameras.resize(2);
+  r.quality.resize(2);
   r.quality[0].name = "left";
   r.quality[1].name = "right";
   r.cameras[0].width = r.cameras[1].width = 64;
@@ -69,6 +71,8 @@ TEST(Report, YamlAndCoverageFiles) {
   RigCalOptions opt;
   const std::string y = format_report_yaml(r, opt);
   EXPECT_NE(y.find("frames_total: 10"), std::string::npos);
+  EXPECT_NE(y.find("camera_count: 2\n"), std::string::npos);
+  EXPECT_NE(y.find("    t_cam_cam0_mm: [0.0000, 0.0000, 0.0000]\n"), std::string::npos) << y;
   EXPECT_NE(y.find("- \"a \\\"quoted\\\" warning\""), std::string::npos);
   const RgbImage cov = coverage_image(r.quality[0], r.cameras[0], 16, 12);
   EXPECT_EQ(cov.width, 32);

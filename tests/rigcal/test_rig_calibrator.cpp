@@ -20,7 +20,7 @@ double rot_err_deg(const Mat3& a, const Mat3& b) {
 }
 
 // Frames with every marker in both images, in wand order (no strays in these blobs).
-void make_frames(const std::array<CameraModel, 2>& cams, int n, std::vector<WandFrame>& frames,
+void make_frames(const std::vector<CameraModel>& cams, int n, std::vector<WandFrame>& frames,
                  std::vector<WandPose>& poses) {
   (void)cams;  // the blobs come from the true cameras in the simulator's world
   const auto world = true_cameras();
@@ -146,7 +146,7 @@ TEST(GroundFrame, FromLFrameObservations) {
   const Iso3 T_world_lframe = sim::simulated_T_world_lframe();
   std::mt19937_64 rng(3);
   std::normal_distribution<double> g(0.0, 0.05);
-  FrameBlobs blobs(10);
+  FrameBlobs blobs(10, std::vector<std::vector<Vec2>>(2));
   for (auto& fb : blobs) {
     for (std::size_t c = 0; c < 2; ++c) {
       for (const Vec3& p : lf.markers_mm) {
