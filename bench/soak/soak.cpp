@@ -14,11 +14,11 @@
 // RSS comes from /proc/self/statm, read between windows (processor mode) or once a
 // second by the main thread (pipeline mode): never inside the measured work.
 // Usage: bench_soak [--frames N] [--window W] [--loop L] [--pipeline] [--csv FILE]
-#include <array>
 #include <time.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -154,7 +154,8 @@ int run_processor(const Args& a, const hal::SimFrameLoop& loop) {
       const ImageView v0 = loop.image(f, 0).view(), v1 = loop.image(f, 1).view();
       const std::int64_t c0 = thread_cpu_ns();
       const auto t0 = std::chrono::steady_clock::now();
-      proc->process(std::array<const ImageView*, 2>{&v0, &v1}, static_cast<std::int64_t>(i) * period_ns, out);
+      proc->process(std::array<const ImageView*, 2>{&v0, &v1},
+                    static_cast<std::int64_t>(i) * period_ns, out);
       const auto t1 = std::chrono::steady_clock::now();
       cpu_ns.push_back(thread_cpu_ns() - c0);
       ns.push_back(std::chrono::duration_cast<std::chrono::nanoseconds>(t1 - t0).count());

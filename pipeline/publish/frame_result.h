@@ -18,11 +18,11 @@
 
 namespace mocap::publish {
 
-inline constexpr int kMaxResultBodies = 16;    // = identify's kMaxBodies
-inline constexpr int kMaxResultMarkers = 256;  // labelled markers per frame
-inline constexpr int kMaxResultPoints = 256;   // 3D points per frame (= kMaxPoints)
+inline constexpr int kMaxResultBodies = 16;            // = identify's kMaxBodies
+inline constexpr int kMaxResultMarkers = 256;          // labelled markers per frame
+inline constexpr int kMaxResultPoints = 256;           // 3D points per frame (= kMaxPoints)
 inline constexpr int kMaxResultCameras = kMaxCameras;  // cameras with blobs
-inline constexpr int kMaxResultBlobs = 64;     // blobs per camera
+inline constexpr int kMaxResultBlobs = 64;             // blobs per camera
 
 struct ResultBody {
   std::uint8_t found = 0;    // 1: the body was found in this frame

@@ -37,9 +37,7 @@ class BlobRefs {
 
   constexpr std::int16_t& operator[](std::size_t c) noexcept { return index_[c]; }
   constexpr std::int16_t operator[](std::size_t c) const noexcept { return index_[c]; }
-  constexpr std::int16_t& operator[](int c) noexcept {
-    return index_[static_cast<std::size_t>(c)];
-  }
+  constexpr std::int16_t& operator[](int c) noexcept { return index_[static_cast<std::size_t>(c)]; }
   constexpr std::int16_t operator[](int c) const noexcept {
     return index_[static_cast<std::size_t>(c)];
   }

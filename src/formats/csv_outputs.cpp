@@ -95,8 +95,8 @@ void write_row(CsvFile& f, const AngleRow& r) noexcept {
                static_cast<long long>(r.frame), static_cast<long long>(r.timestamp_ns),
                r.joint.c_str(), joint_type_name(r.type), r.angles_deg.x(), r.angles_deg.y(),
                r.angles_deg.z(), q.w(), q.x(), q.y(), q.z(),
-               r.solved_by.empty() ? "none" : r.solved_by.c_str(), r.sd_deg.x(),
-               r.sd_deg.y(), r.sd_deg.z());
+               r.solved_by.empty() ? "none" : r.solved_by.c_str(), r.sd_deg.x(), r.sd_deg.y(),
+               r.sd_deg.z());
 }
 
 Expected<std::vector<PointRow>> read_points_csv(const std::string& path) {

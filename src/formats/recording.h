@@ -36,8 +36,8 @@ class Recording;
 class FrameSetLoader {
  public:
   struct Result {
-    int missing = 0;  // cameras whose file does not exist (a dropped frame)
-    int damaged = 0;  // cameras whose file exists but is malformed (see `problem`)
+    int missing = 0;      // cameras whose file does not exist (a dropped frame)
+    int damaged = 0;      // cameras whose file exists but is malformed (see `problem`)
     std::string problem;  // the first damaged file's one-line error, empty if none
   };
   explicit FrameSetLoader(const Recording& rec);

@@ -65,7 +65,8 @@ bool FramePoints::available(int i) const noexcept {
   if (!valid_[s] || point_uses_[s] != 0) return false;
   for (int c = 0; c < kMaxCameras; ++c) {
     const std::int16_t b = blob_[s][c];
-    if (b >= 0 && blob_uses_[static_cast<std::size_t>(c)][static_cast<std::size_t>(b)] != 0) return false;
+    if (b >= 0 && blob_uses_[static_cast<std::size_t>(c)][static_cast<std::size_t>(b)] != 0)
+      return false;
   }
   return true;
 }

@@ -37,9 +37,7 @@ class FramePoints {
   int size() const noexcept { return n_; }
   const Vec3& X(int i) const noexcept { return X_[static_cast<std::size_t>(i)]; }
   bool partial(int i) const noexcept { return partial_[static_cast<std::size_t>(i)] != 0; }
-  const BlobRefs& blobs(int i) const noexcept {
-    return blob_[static_cast<std::size_t>(i)];
-  }
+  const BlobRefs& blobs(int i) const noexcept { return blob_[static_cast<std::size_t>(i)]; }
   const PointPair* pairs() const noexcept { return pairs_.data(); }
   int pair_count() const noexcept { return pair_count_; }
 

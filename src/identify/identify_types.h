@@ -24,7 +24,7 @@ inline constexpr int kMaxBestPairs = 1024;  // bound of IdentifyConfig::best_pai
 // mutually exclusive (epipolar ambiguity): a solution uses at most one of them.
 struct MeasuredPoint {
   Vec3 X_world = Vec3::Zero();  // mm
-  BlobRefs blob_index;  // per camera of the rig; -1: not seen by that camera
+  BlobRefs blob_index;          // per camera of the rig; -1: not seen by that camera
   // The image of the marker does not look whole in some camera (partly occluded, split
   // from a merged blob, cut by the border): its centroid may be biased. Such a point is
   // identified like any other but left out of the pose fit while 3 whole markers remain.

@@ -2,6 +2,7 @@
 #include "stereo/multiview.h"
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 
 #include "stereo/nview.h"
@@ -20,6 +21,8 @@ Expected<MultiViewMerger> MultiViewMerger::create(const Rig& rig, const MultiVie
     return Error{"multiview: " + std::to_string(n) + " cameras, expected 2.." +
                  std::to_string(kMaxCameras)};
   if (!(config.gate_px > 0.0)) return Error{"multiview: gate_px must be positive"};
+  if (!(config.marker_radius_mm >= 0.0) || !std::isfinite(config.marker_radius_mm))
+    return Error{"multiview: marker_radius_mm must be >= 0"};
   if (config.max_points_per_camera < 1 || config.max_hypotheses < 1)
     return Error{"multiview: max_points_per_camera and max_hypotheses must be positive"};
   return MultiViewMerger(rig, config);
@@ -31,19 +34,33 @@ MultiViewMerger::MultiViewMerger(const Rig& rig, const MultiViewConfig& config)
       hyp_(static_cast<std::size_t>(config.max_hypotheses)),
       views_(static_cast<std::size_t>(config.max_hypotheses)),
       extended_(static_cast<std::size_t>(config.max_hypotheses)),
+      unfit_(static_cast<std::size_t>(config.max_hypotheses)),
+      out_hyp_(static_cast<std::size_t>(config.max_hypotheses)),
       order_(static_cast<std::size_t>(config.max_hypotheses)),
       taken_by_(rig.cameras.size() * static_cast<std::size_t>(config.max_points_per_camera)) {}
 
+double MultiViewMerger::unfit_gate_px(int c, const Vec3& X_world) const noexcept {
+  const CameraModel& cam = cams_[static_cast<std::size_t>(c)];
+  const double z = (cam.R_cam_world * X_world + cam.t_cam_world).z();
+  if (!(z > 0.0)) return 0.0;
+  return config_.gate_px + cam.fx * config_.marker_radius_mm / z;
+}
+
 // Adds every camera not yet used whose nearest blob lies within the gate of the
-// projection (the nearest one only: two blobs within 2 px are one marker's split).
-void MultiViewMerger::extend(Point3& h, const Vec2* const* px, const int* n) noexcept {
+// projection (the nearest one only: two blobs within 2 px are one marker's split); a
+// nearest blob beyond the gate but within the unfit gate is recorded as an unfit view.
+void MultiViewMerger::extend(int i, const Vec2* const* px, const int* n) noexcept {
+  Point3& h = hyp_[static_cast<std::size_t>(i)];
+  BlobRefs& unfit = unfit_[static_cast<std::size_t>(i)];
+  unfit = BlobRefs{};
   for (int c = 0; c < camera_count(); ++c) {
-    if (h.blob_index[static_cast<std::size_t>(c)] >= 0) continue;
+    if (h.blob_index[c] >= 0) continue;
     Vec2 q;
     if (!project(cams_[static_cast<std::size_t>(c)], h.X_world, q)) continue;  // behind
     const int m = std::min(n[c], config_.max_points_per_camera);
+    const double wide = std::max(config_.gate_px, unfit_gate_px(c, h.X_world));
     int best = -1;
-    double best_d2 = config_.gate_px * config_.gate_px;
+    double best_d2 = wide * wide;
     for (int j = 0; j < m; ++j) {
       const double d2 = (px[c][j] - q).squaredNorm();
       if (d2 <= best_d2) {
@@ -51,23 +68,29 @@ void MultiViewMerger::extend(Point3& h, const Vec2* const* px, const int* n) noe
         best = j;
       }
     }
-    if (best >= 0) {
-      h.blob_index[static_cast<std::size_t>(c)] = static_cast<std::int16_t>(best);
+    if (best < 0) continue;
+    if (best_d2 <= config_.gate_px * config_.gate_px) {
+      h.blob_index[c] = static_cast<std::int16_t>(best);
       ++counters_.views_added;
+    } else {
+      unfit[c] = static_cast<std::int16_t>(best);
+      ++counters_.unfit_views;
     }
   }
 }
 
 // Gauss-Newton over the views; the worst view beyond the gate is dropped (while more
-// than two remain) and the point refined again.
-void MultiViewMerger::refine(Point3& h, const Vec2* const* px) noexcept {
+// than two remain) and the point refined again. A dropped view within the unfit gate is
+// recorded as an unfit view.
+void MultiViewMerger::refine(int i, const Vec2* const* px) noexcept {
+  Point3& h = hyp_[static_cast<std::size_t>(i)];
   for (;;) {
     const CameraModel* cams[kMaxCameras];
     Vec2 obs[kMaxCameras];
     int cam_of[kMaxCameras];
     int k = 0;
     for (int c = 0; c < camera_count(); ++c) {
-      const int j = h.blob_index[static_cast<std::size_t>(c)];
+      const int j = h.blob_index[c];
       if (j < 0) continue;
       cams[k] = &cams_[static_cast<std::size_t>(c)];
       obs[k] = px[c][j];
@@ -79,12 +102,12 @@ void MultiViewMerger::refine(Point3& h, const Vec2* const* px) noexcept {
     if (!refine_gauss_newton(cams, obs, k, X, rms, kRefineIterations)) return;
     int worst = -1;
     double worst_d = config_.gate_px;
-    for (int i = 0; i < k; ++i) {
+    for (int v = 0; v < k; ++v) {
       Vec2 q;
-      const double d = project(*cams[i], X, q) ? (q - obs[i]).norm() : 1e300;
+      const double d = project(*cams[v], X, q) ? (q - obs[v]).norm() : 1e300;
       if (d > worst_d) {
         worst_d = d;
-        worst = i;
+        worst = v;
       }
     }
     if (worst < 0) {
@@ -92,9 +115,29 @@ void MultiViewMerger::refine(Point3& h, const Vec2* const* px) noexcept {
       h.reproj_px = rms;
       return;
     }
-    h.blob_index[static_cast<std::size_t>(cam_of[worst])] = -1;
+    const int c = cam_of[worst];
+    if (worst_d <= unfit_gate_px(c, X)) {
+      unfit_[static_cast<std::size_t>(i)][c] = h.blob_index[c];
+      ++counters_.unfit_views;
+    }
+    h.blob_index[c] = -1;
     ++counters_.views_dropped;
   }
+}
+
+bool MultiViewMerger::is_unfit_pairing(int i, int o) const noexcept {
+  const BlobRefs& mine = hyp_[static_cast<std::size_t>(i)].blob_index;
+  const int oh = out_hyp_[static_cast<std::size_t>(o)];
+  const BlobRefs& used = hyp_[static_cast<std::size_t>(oh)].blob_index;
+  const BlobRefs& unfit = unfit_[static_cast<std::size_t>(oh)];
+  bool any_unfit = false;
+  for (int c = 0; c < camera_count(); ++c) {
+    const int j = mine[c];
+    if (j < 0 || j == used[c]) continue;
+    if (j != unfit[c]) return false;
+    any_unfit = true;
+  }
+  return any_unfit;
 }
 
 bool MultiViewMerger::refit(Point3& p, const Vec2* const* px) const noexcept {
@@ -151,15 +194,17 @@ bool MultiViewMerger::process(const Vec2* const* px, const int* n, const PointLi
   }
   for (int i = 0; i < count; ++i) {
     Point3& h = hyp_[static_cast<std::size_t>(i)];
-    extend(h, px, n);
+    extend(i, px, n);
     extended_[static_cast<std::size_t>(i)] = h.blob_index;
     int same = -1;  // the same point from another pair: the same blobs once extended
     for (int k = 0; k < i && same < 0; ++k)
       if (extended_[static_cast<std::size_t>(k)] == h.blob_index) same = k;
-    if (same >= 0)
+    if (same >= 0) {
       h = hyp_[static_cast<std::size_t>(same)];  // refined already
-    else
-      refine(h, px);
+      unfit_[static_cast<std::size_t>(i)] = unfit_[static_cast<std::size_t>(same)];
+    } else {
+      refine(i, px);
+    }
     views_[static_cast<std::size_t>(i)] = h.blob_index.count();
     order_[static_cast<std::size_t>(i)] = i;
   }
@@ -176,42 +221,47 @@ bool MultiViewMerger::process(const Vec2* const* px, const int* n, const PointLi
     const int i = order_[static_cast<std::size_t>(r)];
     Point3 h = hyp_[static_cast<std::size_t>(i)];
     const int views = views_[static_cast<std::size_t>(i)];
-    int owner = -1;  // a taken point using one of h's blobs
-    bool all_same_owner = true, any_free = false, richer_owner = false;
+    // The taken points using one of h's blobs (at most one per camera).
+    int owners[kMaxCameras];
+    int n_owners = 0;
+    bool richer_owner = false;
     for (int c = 0; c < camera_count(); ++c) {
-      const int j = h.blob_index[static_cast<std::size_t>(c)];
+      const int j = h.blob_index[c];
       if (j < 0) continue;
       const int o =
           j < config_.max_points_per_camera
               ? taken_by_[static_cast<std::size_t>(c) * per_cam + static_cast<std::size_t>(j)]
               : -1;
-      if (o < 0) {
-        any_free = true;
-        all_same_owner = false;
-        continue;
-      }
-      if (owner >= 0 && o != owner) all_same_owner = false;
-      owner = o;
+      if (o < 0) continue;
+      if (std::find(owners, owners + n_owners, o) == owners + n_owners) owners[n_owners++] = o;
       richer_owner = richer_owner || out[o].blob_index.count() > views;
     }
-    if (owner >= 0 && all_same_owner && !any_free) {
+    const bool same_as_taken = std::any_of(owners, owners + n_owners, [&](int o) {
+      return hyp_[static_cast<std::size_t>(out_hyp_[static_cast<std::size_t>(o)])].blob_index ==
+             h.blob_index;
+    });
+    if (same_as_taken) {
       ++counters_.merged;  // the same blobs: the same point from another pair
+      continue;
+    }
+    if (n_owners == 1 && is_unfit_pairing(i, owners[0])) {
+      ++counters_.unfit_pairings;  // the owner's marker, paired through its unfit view
       continue;
     }
     if (richer_owner) {
       ++counters_.ghosts_rejected;  // a blob of a point that more cameras confirm
       continue;
     }
-    h.ambiguous = owner >= 0;
+    h.ambiguous = n_owners > 0;
     h.reported = !h.ambiguous;
-    if (out.size() >= out.capacity()) {
+    if (out.size() >= out.capacity() || static_cast<std::size_t>(out.size()) >= out_hyp_.size()) {
       ++counters_.point_overflow;
       complete = false;
       continue;
     }
     const int index = out.size();
     for (int c = 0; c < camera_count(); ++c) {
-      const int j = h.blob_index[static_cast<std::size_t>(c)];
+      const int j = h.blob_index[c];
       if (j < 0 || j >= config_.max_points_per_camera) continue;
       int& slot = taken_by_[static_cast<std::size_t>(c) * per_cam + static_cast<std::size_t>(j)];
       if (slot >= 0 && !out[slot].ambiguous) {
@@ -222,6 +272,7 @@ bool MultiViewMerger::process(const Vec2* const* px, const int* n, const PointLi
       if (slot < 0) slot = index;
     }
     if (h.ambiguous) ++counters_.ambiguous;
+    out_hyp_[static_cast<std::size_t>(index)] = i;
     out.push_back(h);
     ++counters_.points;
   }

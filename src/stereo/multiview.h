@@ -13,6 +13,14 @@
 //      rejected through the third view; one that shares a blob with a taken point seen
 //      by as many cameras stays, and both are flagged ambiguous (not reported): the
 //      identification resolves them by evidence, exactly as for two cameras.
+// Unfit views of the same marker: a ball partly hidden from one camera has a centroid
+// shifted by up to its image radius, beyond gate_px, so that camera's blob pairs with each
+// of the other views into 2-view hypotheses a few millimetres off the marker (a triangle
+// of pairings). A blob of a camera not in a point, within gate_px + the ball's image
+// radius (fx * marker_radius_mm / depth) of its projection, or a view the refinement
+// dropped within that bound, is recorded as the point's unfit view; a later hypothesis
+// made only of the point's blobs and its unfit views is that marker again (`merged`),
+// not a rival.
 // A 2-view point that no third camera confirms is still reported: under occlusion a
 // camera that should see a marker often does not, so absence is no evidence, and a
 // consistent pair of stray blobs is a point like any other for the identification,
@@ -40,6 +48,9 @@ struct MultiViewConfig {
   double gate_px = 2.0;
   int max_points_per_camera = 256;  // blobs per camera considered (as StereoConfig)
   int max_hypotheses = 2048;        // pairwise candidates considered per frame
+  // Radius of the marker balls (mm; the targets' marker_diameter / 2): bounds how far a
+  // partly hidden ball's centroid can move. 0: no unfit views are recorded.
+  double marker_radius_mm = 0.0;
 };
 
 struct MultiViewCounters {
@@ -49,6 +60,8 @@ struct MultiViewCounters {
   std::uint64_t views_added = 0;          // third and further views found by projection
   std::uint64_t views_dropped = 0;        // views removed as outliers after refinement
   std::uint64_t merged = 0;               // the same point from another camera pair
+  std::uint64_t unfit_views = 0;          // blobs recorded as a point's unfit view
+  std::uint64_t unfit_pairings = 0;       // hypotheses made of a point and its unfit views
   std::uint64_t ghosts_rejected = 0;      // lost to a point seen by more cameras
   std::uint64_t ambiguous = 0;            // emitted points flagged ambiguous
   std::uint64_t points = 0;               // emitted points
@@ -79,16 +92,22 @@ class MultiViewMerger {
 
  private:
   MultiViewMerger(const Rig& rig, const MultiViewConfig& config);
-  void extend(Point3& h, const Vec2* const* px, const int* n) noexcept;
-  void refine(Point3& h, const Vec2* const* px) noexcept;
+  void extend(int i, const Vec2* const* px, const int* n) noexcept;
+  void refine(int i, const Vec2* const* px) noexcept;
+  // gate_px plus the marker's image radius in camera c at X_world (0: behind).
+  double unfit_gate_px(int c, const Vec3& X_world) const noexcept;
+  // Whether hypothesis i consists of taken point o's blobs and unfit views only.
+  bool is_unfit_pairing(int i, int o) const noexcept;
 
   std::vector<CameraModel> cams_;
   MultiViewConfig config_;
-  std::vector<Point3> hyp_;  // workspace: this frame's hypotheses
-  std::vector<int> views_;   // views per hypothesis
+  std::vector<Point3> hyp_;         // workspace: this frame's hypotheses
+  std::vector<int> views_;          // views per hypothesis
   std::vector<BlobRefs> extended_;  // blobs before refinement
-  std::vector<int> order_;                                       // hypotheses in acceptance order
-  std::vector<int> taken_by_;  // [camera * max_points_per_camera + blob]: output index
+  std::vector<BlobRefs> unfit_;     // per hypothesis: its unfit views
+  std::vector<int> out_hyp_;        // per output point: the hypothesis it came from
+  std::vector<int> order_;          // hypotheses in acceptance order
+  std::vector<int> taken_by_;       // [camera * max_points_per_camera + blob]: output index
   MultiViewCounters counters_;
 };
 

@@ -38,8 +38,8 @@ struct Point3 {
   Vec3 X_world = Vec3::Zero();  // mm, world frame
   double reproj_px = 0.0;       // RMS reprojection error over the used views, real pixels
   double epipolar_px = 0.0;     // max of the two symmetric epipolar distances (undistorted px)
-  BlobRefs blob_index;  // blob per camera of the rig; -1: camera unused
-  bool ambiguous = false;  // shares a blob with another candidate of the same frame
+  BlobRefs blob_index;          // blob per camera of the rig; -1: camera unused
+  bool ambiguous = false;       // shares a blob with another candidate of the same frame
   // Reported as a marker (points.csv): the stereo stage reports exactly the unambiguous
   // candidates; track/point_selection.h then resolves the ambiguous ones by evidence.
   bool reported = false;

@@ -25,7 +25,8 @@ std::array<double, 3> euler_sd_of(const Mat3& R, const Mat3& cov) noexcept {
   Mat3 J;
   for (int k = 0; k < 3; ++k) {
     const Vec3 e = Vec3::Unit(k);
-    Vec3 diff = rotation_to_euler_xyz(exp_hinge(e, h) * R) - rotation_to_euler_xyz(exp_hinge(e, -h) * R);
+    Vec3 diff =
+        rotation_to_euler_xyz(exp_hinge(e, h) * R) - rotation_to_euler_xyz(exp_hinge(e, -h) * R);
     for (int i = 0; i < 3; ++i) diff[i] = std::remainder(diff[i], 2.0 * std::numbers::pi);
     J.col(k) = diff / (2.0 * h);
   }
@@ -36,8 +37,8 @@ std::array<double, 3> euler_sd_of(const Mat3& R, const Mat3& cov) noexcept {
 
 }  // namespace
 
-void ChainSolver::solve(const MeasuredPoint* pts, int n, std::int64_t t_ns,
-                        const BodyPoses& poses, ChainResult& out) noexcept {
+void ChainSolver::solve(const MeasuredPoint* pts, int n, std::int64_t t_ns, const BodyPoses& poses,
+                        ChainResult& out) noexcept {
   ++counters_.frames;
   n = std::clamp(n, 0, kMaxPoints);
   const int nj = model_.joint_count();
@@ -72,7 +73,8 @@ void ChainSolver::solve(const MeasuredPoint* pts, int n, std::int64_t t_ns,
           used_blob[c].set(static_cast<std::size_t>(bi));
       }
     };
-    for (int p = 0; p < n; ++p) available_[static_cast<std::size_t>(p)] = pts[p].X_world.allFinite();
+    for (int p = 0; p < n; ++p)
+      available_[static_cast<std::size_t>(p)] = pts[p].X_world.allFinite();
     for (int b = 0; b < nb; ++b) {
       if (!found(b)) continue;
       for (const std::int16_t p : poses.bodies[static_cast<std::size_t>(b)].point_index_of_marker)
@@ -140,8 +142,8 @@ void ChainSolver::solve(const MeasuredPoint* pts, int n, std::int64_t t_ns,
           for (std::size_t m = 0; m < markers.size(); ++m) {
             const int p = out.point_index_of_marker[ub][m];
             if (p < 0) continue;
-            const double e =
-                (out.T_world_body[ub] * markers[m] - pts[p].X_world).squaredNorm() / sigma_sq(pts[p]);
+            const double e = (out.T_world_body[ub] * markers[m] - pts[p].X_world).squaredNorm() /
+                             sigma_sq(pts[p]);
             if (e > worst) worst = e, wb = b, wm = static_cast<int>(m);
           }
         }
@@ -199,12 +201,12 @@ void ChainSolver::solve(const MeasuredPoint* pts, int n, std::int64_t t_ns,
     if (r.solved_by != client::SolvedBy::kNone) continue;
     const ChainJoint& cj = model_.joint(j);
     if (cj.parent >= nb || cj.child >= nb || !anchored(cj.parent) || !anchored(cj.child)) continue;
-    r.solved_by = found(cj.parent) && found(cj.child) ? client::SolvedBy::kPoses
-                                                      : client::SolvedBy::kChain;
+    r.solved_by =
+        found(cj.parent) && found(cj.child) ? client::SolvedBy::kPoses : client::SolvedBy::kChain;
     const Mat3 R_wp = pose_of(cj.parent).linear();
     const Mat3 R_rel = R_wp.transpose() * pose_of(cj.child).linear();
-    const Mat3 cov = R_wp.transpose() * (body_cov(cj.parent, poses, out) +
-                                         body_cov(cj.child, poses, out)) * R_wp;
+    const Mat3 cov = R_wp.transpose() *
+                     (body_cov(cj.parent, poses, out) + body_cov(cj.child, poses, out)) * R_wp;
     if (cj.dof == 1) {
       r.sd_rad = {std::sqrt(std::max(0.0, cj.axis_parent.dot(cov * cj.axis_parent))), 0.0, 0.0};
     } else {
@@ -220,7 +222,8 @@ void ChainSolver::solve(const MeasuredPoint* pts, int n, std::int64_t t_ns,
 
 std::array<double, 3> ChainSolver::active_sd(int j) const noexcept {
   const auto uj = static_cast<std::size_t>(j);
-  if (model_.joint(j).dof == 1) return {sd_dof_[static_cast<std::size_t>(dof_offset_[uj])], 0.0, 0.0};
+  if (model_.joint(j).dof == 1)
+    return {sd_dof_[static_cast<std::size_t>(dof_offset_[uj])], 0.0, 0.0};
   return euler_sd_of(R_rel_[uj], cov_[uj]);
 }
 

@@ -34,6 +34,7 @@ Expected<FrameProcessor> FrameProcessor::create(const Rig& rig, const TargetSet&
   MultiViewConfig mvc = config.multiview;
   mvc.max_points_per_camera = config.stereo.max_points_per_camera;
   mvc.max_hypotheses = std::max(1, config.stereo.max_candidates) * std::max(1, n_pairs);
+  if (targets.marker_diameter_mm > 0.0) mvc.marker_radius_mm = 0.5 * targets.marker_diameter_mm;
   auto merger = MultiViewMerger::create(rig, mvc);
   if (!merger) return Error{"multi-view: " + merger.error().message};
   auto ident = Identifier::create(targets, config.identify);
@@ -80,7 +81,8 @@ Expected<FrameProcessor> FrameProcessor::create(const Rig& rig, const TargetSet&
   p.centroids_px_.assign(static_cast<std::size_t>(n_cams),
                          std::vector<Vec2>(static_cast<std::size_t>(config.detect.max_blobs)));
   if (n_cams > 2)
-    p.pair_points_.assign(static_cast<std::size_t>(n_pairs), PointList(config.stereo.max_candidates));
+    p.pair_points_.assign(static_cast<std::size_t>(n_pairs),
+                          PointList(config.stereo.max_candidates));
   p.measured_.resize(static_cast<std::size_t>(std::max(1, config.stereo.max_candidates)));
   p.body_views_.resize(targets.bodies.size());
   return p;
@@ -115,8 +117,8 @@ bool FrameProcessor::detect_camera(int camera, const ImageView& image,
   return detectors_[static_cast<std::size_t>(camera)].detect(image, out);
 }
 
-bool FrameProcessor::process(std::span<const ImageView* const> views,
-                             std::int64_t timestamp_ns, FrameOutput& out) noexcept {
+bool FrameProcessor::process(std::span<const ImageView* const> views, std::int64_t timestamp_ns,
+                             FrameOutput& out) noexcept {
   const std::int64_t t0 = monotonic_ns();
   for (int c = 0; c < camera_count(); ++c) {
     const auto uc = static_cast<std::size_t>(c);
@@ -195,7 +197,8 @@ void FrameProcessor::sum_stereo_counters() noexcept {
 void FrameProcessor::measure_points(FrameOutput& out) noexcept {
   const int n_points = std::min(out.points.size(), static_cast<int>(measured_.size()));
   const Vec2* px[kMaxCameras] = {};
-  for (int c = 0; c < camera_count(); ++c) px[c] = centroids_px_[static_cast<std::size_t>(c)].data();
+  for (int c = 0; c < camera_count(); ++c)
+    px[c] = centroids_px_[static_cast<std::size_t>(c)].data();
   for (int i = 0; i < n_points; ++i) {
     Point3& p = out.points[i];
     // Which views look like a whole marker at the point's position.

@@ -31,8 +31,8 @@
 #include "formats/joints_yaml.h"
 #include "formats/targets_yaml.h"
 #include "identify/identifier.h"
-#include "stereo/multiview.h"
 #include "kinematics/joint_angles.h"
+#include "stereo/multiview.h"
 #include "stereo/stereo_triangulator.h"
 #include "track/chain_solver.h"
 #include "track/marker_shape.h"
@@ -80,7 +80,7 @@ struct StageTimesNs {
 
 // Everything one frame produces; sized by FrameProcessor::make_output() at setup.
 struct FrameOutput {
-  std::vector<detect::BlobList> blobs;            // one per camera of the rig
+  std::vector<detect::BlobList> blobs;             // one per camera of the rig
   std::array<bool, kMaxCameras> camera_present{};  // false: the camera's frame was missing
   PointList points;
   BodyPoses poses;

@@ -31,6 +31,8 @@ std::vector<std::pair<std::string, std::uint64_t>> collect_counters(const FrameP
     c.emplace_back("multiview_views_added", m.views_added);
     c.emplace_back("multiview_views_dropped", m.views_dropped);
     c.emplace_back("multiview_merged", m.merged);
+    c.emplace_back("multiview_unfit_views", m.unfit_views);
+    c.emplace_back("multiview_unfit_pairings", m.unfit_pairings);
     c.emplace_back("multiview_ghosts_rejected", m.ghosts_rejected);
     c.emplace_back("multiview_ambiguous", m.ambiguous);
     c.emplace_back("multiview_hypothesis_overflow", m.hypothesis_overflow);
@@ -66,17 +68,22 @@ std::vector<std::pair<std::string, std::uint64_t>> collect_counters(const FrameP
 std::string stats_to_json(const TrackStats& stats) {
   std::string out;
   char buf[256];
-  std::snprintf(buf, sizeof buf, "{\"frames\": %lld,\n \"stages\": {", static_cast<long long>(stats.frames));
+  std::snprintf(buf, sizeof buf, "{\"frames\": %lld,\n \"stages\": {",
+                static_cast<long long>(stats.frames));
   out += buf;
   const std::pair<const char*, const LatencyRecorder*> stages[] = {
-      {"detect", &stats.detect},     {"triangulate", &stats.triangulate}, {"identify", &stats.identify},
-      {"angles", &stats.angles},     {"frame", &stats.frame}};
+      {"detect", &stats.detect},
+      {"triangulate", &stats.triangulate},
+      {"identify", &stats.identify},
+      {"angles", &stats.angles},
+      {"frame", &stats.frame}};
   bool first = true;
   for (const auto& [name, rec] : stages) {
     const LatencySummary s = rec->summary();
-    std::snprintf(buf, sizeof buf,
-                  "%s\n   \"%s\": {\"p50_us\": %.3f, \"p99_us\": %.3f, \"max_us\": %.3f, \"mean_us\": %.3f}",
-                  first ? "" : ",", name, s.p50_us, s.p99_us, s.max_us, s.mean_us);
+    std::snprintf(
+        buf, sizeof buf,
+        "%s\n   \"%s\": {\"p50_us\": %.3f, \"p99_us\": %.3f, \"max_us\": %.3f, \"mean_us\": %.3f}",
+        first ? "" : ",", name, s.p50_us, s.p99_us, s.max_us, s.mean_us);
     out += buf;
     first = false;
   }

@@ -4,17 +4,16 @@
 #pragma once
 
 #include <algorithm>
-
 #include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
 
+#include "core/camera_set.h"
 #include "core/expected.h"
 #include "core/types.h"
 #include "formats/csv_outputs.h"
 #include "formats/joints_yaml.h"
-#include "core/camera_set.h"
 #include "formats/targets_yaml.h"
 
 namespace mocap {
@@ -24,8 +23,8 @@ struct GtMarker {
   std::string body;
   int marker = 0;
   Vec3 X_world = Vec3::Zero();
-  int cameras = 0;                      // cameras of the recording (columns uK,vK,visK)
-  std::array<Vec2, kMaxCameras> px{};     // per camera, the first `cameras` entries
+  int cameras = 0;                          // cameras of the recording (columns uK,vK,visK)
+  std::array<Vec2, kMaxCameras> px{};       // per camera, the first `cameras` entries
   std::array<bool, kMaxCameras> visible{};  // visible, unmerged, inside the image
   // Cameras that see the marker cleanly; a 3D point is expected from two or more.
   int views() const noexcept {
@@ -45,7 +44,8 @@ struct GroundTruth {
 Expected<GroundTruth> load_ground_truth(const std::string& gt_dir);
 // Joint angles of `model` for each frame of `poses` (rows sorted by frame), as the
 // tracker computes them (kinematics::JointAngleSolver).
-Expected<std::vector<AngleRow>> true_angles_from_poses(const TargetSet& targets, const JointModel& model,
+Expected<std::vector<AngleRow>> true_angles_from_poses(const TargetSet& targets,
+                                                       const JointModel& model,
                                                        const std::vector<PoseRow>& poses);
 Expected<std::vector<GtMarker>> read_gt_markers_csv(const std::string& path);
 
@@ -54,8 +54,8 @@ struct BodyAccuracy {
   std::int64_t frames_visible = 0;  // frames with >= 3 of its markers visible in >= 2 cameras
   std::int64_t frames_found = 0;    // of those, frames where the tracker found the body
   std::int64_t frames_found_total = 0;
-  std::int64_t wrong = 0;           // found with a pose far from the truth (> 10 mm or > 5 deg)
-  double position_rms_mm = 0.0;     // over correct finds
+  std::int64_t wrong = 0;        // found with a pose far from the truth (> 10 mm or > 5 deg)
+  double position_rms_mm = 0.0;  // over correct finds
   double rotation_rms_deg = 0.0;
 };
 
@@ -68,7 +68,7 @@ struct JointAccuracy {
 
 struct AccuracyReport {
   std::int64_t frames = 0;
-  std::int64_t marker_views = 0;     // markers visible in >= 2 cameras, summed over frames
+  std::int64_t marker_views = 0;      // markers visible in >= 2 cameras, summed over frames
   std::int64_t markers_recalled = 0;  // of those, with a 3D point within 2 mm
   double point_rmse_mm = 0.0;         // over recalled markers
   std::int64_t points = 0;            // all 3D points written

@@ -158,15 +158,15 @@ TEST_F(RigYamlTest, EightCamerasAtMost) {
     c.name = "cam" + std::to_string(rig.cameras.size());
     rig.cameras.push_back(c);
   }
-  const std::string path = dir.file("nine.yaml");
-  ASSERT_TRUE(save_rig(path, rig).ok());
-  auto r = load_rig(path);
+  const std::string file = dir.file("nine.yaml");
+  ASSERT_TRUE(save_rig(file, rig).ok());
+  auto r = load_rig(file);
   ASSERT_FALSE(r.ok());
   EXPECT_THAT(r.error().message,
-              AllOf(StartsWith(path + ": cameras: 9 cameras, at most 8 are supported")));
+              AllOf(StartsWith(file + ": cameras: 9 cameras, at most 8 are supported")));
   rig.cameras.pop_back();
-  ASSERT_TRUE(save_rig(path, rig).ok());
-  auto eight = load_rig(path);
+  ASSERT_TRUE(save_rig(file, rig).ok());
+  auto eight = load_rig(file);
   ASSERT_TRUE(eight.ok()) << eight.error().message;
   EXPECT_EQ(eight->cameras.size(), 8u);
 }

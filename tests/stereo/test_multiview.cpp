@@ -109,7 +109,8 @@ struct Stage {
   MultiViewMerger merger;
   PointList out{4096};
 
-  explicit Stage(const Rig& rig) : merger(MultiViewMerger::create(rig, MultiViewConfig{}).value()) {
+  explicit Stage(const Rig& rig, const MultiViewConfig& config = MultiViewConfig{})
+      : merger(MultiViewMerger::create(rig, config).value()) {
     std::array<CameraPair, kMaxCameraPairs> cp{};
     const int np = enumerate_camera_pairs(static_cast<int>(rig.cameras.size()), cp);
     for (int k = 0; k < np; ++k) {
@@ -239,10 +240,13 @@ TEST(MultiView, SetupErrors) {
   one.cameras.resize(1);
   auto e = MultiViewMerger::create(one, MultiViewConfig{});
   ASSERT_FALSE(e.ok());
-  EXPECT_EQ(e.error().message, "multiview: 1 cameras, expected 2..4");
+  EXPECT_EQ(e.error().message, "multiview: 1 cameras, expected 2..8");
   MultiViewConfig bad;
   bad.gate_px = 0.0;
   EXPECT_FALSE(MultiViewMerger::create(test::paper_rig(), bad).ok());
+  MultiViewConfig negative;
+  negative.marker_radius_mm = -1.0;
+  EXPECT_FALSE(MultiViewMerger::create(test::paper_rig(), negative).ok());
 }
 
 }  // namespace

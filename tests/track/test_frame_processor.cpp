@@ -1,7 +1,8 @@
 // Tests of the FrameProcessor: steady-state processing allocates nothing, a missing
 // camera frame yields no 3D points, damaged images never crash.
-#include <array>
 #include <gtest/gtest.h>
+
+#include <array>
 
 #include "formats/recording.h"
 #include "formats/targets_yaml.h"
@@ -62,7 +63,8 @@ TEST(FrameProcessor, SteadyStateProcessingAllocatesNothing) {
   }
   proc->reset();  // and the cold path too
   const ImageView v0 = l.images[0][0].view(), v1 = l.images[0][1].view();
-  proc->process(std::array<const ImageView*, 2>{&v0, &v1}, l.rec.frames()[0].timestamp_ns + 1000000000, out);
+  proc->process(std::array<const ImageView*, 2>{&v0, &v1},
+                l.rec.frames()[0].timestamp_ns + 1000000000, out);
   EXPECT_EQ(scope.count(), 0u);
   EXPECT_GT(bodies, 0);  // the work was real
 }

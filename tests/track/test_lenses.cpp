@@ -8,9 +8,9 @@
 //  - the partial-marker classification: clean markers flagged partial (must be ~0) and
 //    markers with >= 30 % of their disc hidden in one image flagged partial;
 //  - bodies with >= 3 clean markers: found, and never with a wrong identity.
-#include <array>
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cstdio>
 #include <cstdlib>
 
