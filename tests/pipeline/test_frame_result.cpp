@@ -117,6 +117,7 @@ TEST(FrameResultBuilder, BlobsSayWhatTheyBecame) {
   targets.bodies.push_back(t);
   auto out = std::make_unique<FrameOutput>();
   out->points.set_capacity(4);
+  out->blobs.resize(2);  // one BlobList per camera
   for (int c = 0; c < 2; ++c) {
     out->blobs[static_cast<std::size_t>(c)] = detect::BlobList(8);
     out->camera_present[static_cast<std::size_t>(c)] = c == 0;
