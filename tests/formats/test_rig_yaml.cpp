@@ -158,7 +158,7 @@ TEST_F(RigYamlTest, EightCamerasAtMost) {
     c.name = "cam" + std::to_string(rig.cameras.size());
     rig.cameras.push_back(c);
   }
-  const std::string path = dir.file("nine.yaml");
+  path = dir.file("nine.yaml");  // the fixture's path member, pointed at this file
   ASSERT_TRUE(save_rig(path, rig).ok());
   auto r = load_rig(path);
   ASSERT_FALSE(r.ok());
