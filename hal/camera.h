@@ -24,7 +24,7 @@
 
 #include "core/expected.h"
 #include "core/image.h"
-#include "hal/rt/counter.h"
+#include "rt/counter.h"
 
 namespace mocap::hal {
 

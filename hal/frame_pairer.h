@@ -1,20 +1,24 @@
-// Design: pairs the frames of the two stereo cameras, whatever backend produced them.
-// A frame is offered as (key, handle): the key is the trigger sequence number
-// (triggered cameras: exact match, tolerance 0) or the sensor timestamp in ns
-// (free-running or libcamera cameras: match within tolerance, which must be below
-// half the frame period). Each camera's frames are assumed to arrive in increasing
-// key order (true for every backend); the two cameras may run ahead of each other.
-//   - A frame whose partner is pending forms a pair at once (the closest key wins).
+// Design: matches the frames of the rig's cameras (2..kMaxCameras) into frame sets,
+// whatever backend produced them. A frame is offered as (key, handle): the key is the
+// trigger sequence number (triggered cameras: exact match, tolerance 0) or the sensor
+// timestamp in ns (free-running or libcamera cameras: match within tolerance of the
+// frame that completes the set; the tolerance must be below half the frame period).
+// Each camera's frames are assumed to arrive in increasing key order (true for every
+// backend); the cameras may run ahead of each other.
+//   - A frame whose partners are pending in EVERY other camera completes a set at once
+//     (per camera, the closest key wins).
 //   - Otherwise it waits in its camera's pending queue (fixed capacity).
-//   - A pending frame is dead when the other camera has already delivered a key at or
-//     beyond it + tolerance (keys increase strictly per camera, so no later frame can
-//     match it): it is dropped (unmatched[camera]).
-//   - A frame that arrives already dead (the other camera is past it) is dropped too.
-//   - When a camera stalls, the other camera's queue fills; the oldest pending frame is
-//     then dropped (overflow[camera]).
+//   - A pending frame is dead when some other camera has already delivered a key at or
+//     beyond it + tolerance and has no pending partner for it (keys increase strictly
+//     per camera, so that camera can never complete its set): it is dropped
+//     (unmatched[camera]).
+//   - A frame that arrives already dead (another camera is past it) is dropped too.
+//   - When a camera stalls, the other cameras' queues fill; their oldest pending frame
+//     is then dropped (overflow[camera]).
 // Every dropped frame is handed to the caller's on_drop(camera, entry) so that its
-// buffer goes back to its camera. Pure logic: no clock, no I/O; noexcept and
-// allocation-free after create().
+// buffer goes back to its camera. The class keeps its two-camera name (a set of two is
+// a pair). Pure logic: no clock, no I/O; noexcept and allocation-free after create().
+// Cost per push: O(cameras x pending^2) comparisons, pending <= max_pending (small).
 #pragma once
 
 #include <cstdint>
@@ -22,8 +26,9 @@
 #include <string>
 #include <vector>
 
+#include "core/camera_set.h"
 #include "core/expected.h"
-#include "hal/rt/counter.h"
+#include "rt/counter.h"
 
 namespace mocap::hal {
 
@@ -32,19 +37,21 @@ struct PairEntry {
   std::uint32_t handle = 0;  // the caller's buffer/slot handle
 };
 
+// One frame per camera; entries past the pairer's camera count are unused.
 struct FramePair {
-  PairEntry cam[2];
+  PairEntry cam[kMaxCameras];
 };
 
 struct PairerConfig {
   std::int64_t tolerance = 0;     // 0 for sequence numbers; e.g. 1'000'000 ns for timestamps
   std::uint32_t max_pending = 8;  // per camera
+  int cameras = 2;                // kMinCameras..kMaxCameras
 };
 
 struct PairerCounters {
   rt::Counter pairs;
-  rt::Counter unmatched[2];  // dropped: the other camera never delivered a partner
-  rt::Counter overflow[2];   // dropped: pending queue full (the other camera stalled)
+  rt::Counter unmatched[kMaxCameras];  // dropped: another camera never delivered a partner
+  rt::Counter overflow[kMaxCameras];   // dropped: pending queue full (another camera stalled)
 };
 
 class FramePairer {
@@ -55,36 +62,46 @@ class FramePairer {
       return make_error("FramePairer", "max_pending",
                         "must be in 1..1024, got " + std::to_string(config.max_pending));
     }
+    if (config.cameras < kMinCameras || config.cameras > kMaxCameras) {
+      return make_error("FramePairer", "cameras",
+                        std::to_string(config.cameras) + " cameras, expected " +
+                            std::to_string(kMinCameras) + ".." + std::to_string(kMaxCameras));
+    }
     return FramePairer(config);
   }
 
-  // Offers camera `camera`'s (0 or 1) frame. True when it completed `pair` (cam[0] is
-  // camera 0's frame). Frames that can no longer be paired go to on_drop(camera, entry).
+  // Offers camera `camera`'s (0..cameras-1) frame. True when it completed `pair`
+  // (cam[c] is camera c's frame). Frames that can no longer be matched go to
+  // on_drop(camera, entry).
   template <class OnDrop>
   bool push(int camera, const PairEntry& e, FramePair& pair, OnDrop&& on_drop) noexcept {
-    const int other = 1 - camera;
+    const int n = config_.cameras;
     if (!has_latest_[camera] || e.key > latest_[camera]) latest_[camera] = e.key;
     has_latest_[camera] = true;
-    bool paired = false;
-    Queue& oq = pending_[other];
-    // The closest pending partner within tolerance.
-    std::uint32_t best = oq.count;
-    std::int64_t best_dk = 0;
-    for (std::uint32_t i = 0; i < oq.count; ++i) {
-      const std::int64_t dk = std::llabs(oq.at(i).key - e.key);
-      if (dk <= config_.tolerance && (best == oq.count || dk < best_dk)) {
-        best = i;
-        best_dk = dk;
+    // The closest pending partner within tolerance in every other camera.
+    std::uint32_t best[kMaxCameras] = {};
+    bool complete = true;
+    bool dead = false;
+    for (int o = 0; o < n; ++o) {
+      if (o == camera) continue;
+      best[o] = closest(o, e.key);
+      if (best[o] == pending_[o].count) {
+        complete = false;
+        // Camera o's later keys are all > latest_[o] >= key + tolerance.
+        if (has_latest_[o] && e.key + config_.tolerance <= latest_[o]) dead = true;
       }
     }
-    if (best != oq.count) {
+    bool paired = false;
+    if (complete) {
       pair.cam[camera] = e;
-      pair.cam[other] = oq.at(best);
-      oq.erase(best);
+      for (int o = 0; o < n; ++o) {
+        if (o == camera) continue;
+        pair.cam[o] = pending_[o].at(best[o]);
+        pending_[o].erase(best[o]);
+      }
       counters_.pairs.add();
       paired = true;
-    } else if (has_latest_[other] && e.key + config_.tolerance <= latest_[other]) {
-      // The other camera's later keys are all > latest_[other] >= key + tolerance.
+    } else if (dead) {
       counters_.unmatched[camera].add();
       on_drop(camera, e);
     } else {
@@ -96,12 +113,22 @@ class FramePairer {
       }
       q.push_back(e);
     }
-    // The other camera's pending frames that camera `camera` has reached are dead: its
-    // next keys are all > latest_[camera] >= key + tolerance.
-    while (oq.count > 0 && oq.at(0).key + config_.tolerance <= latest_[camera]) {
-      counters_.unmatched[other].add();
-      on_drop(other, oq.at(0));
-      oq.erase(0);
+    // The other cameras' pending frames that camera `camera` has passed without a
+    // pending partner are dead: its next keys are all > latest_[camera] >= key + tolerance.
+    for (int o = 0; o < n; ++o) {
+      if (o == camera) continue;
+      Queue& oq = pending_[o];
+      for (std::uint32_t i = 0; i < oq.count;) {
+        const PairEntry p = oq.at(i);
+        if (p.key + config_.tolerance <= latest_[camera] &&
+            closest(camera, p.key) == pending_[camera].count) {
+          counters_.unmatched[o].add();
+          on_drop(o, p);
+          oq.erase(i);
+        } else {
+          ++i;
+        }
+      }
     }
     return paired;
   }
@@ -109,7 +136,7 @@ class FramePairer {
   // Hands every pending frame to on_drop (at stop), without counting it.
   template <class OnDrop>
   void flush(OnDrop&& on_drop) noexcept {
-    for (int c = 0; c < 2; ++c) {
+    for (int c = 0; c < config_.cameras; ++c) {
       while (pending_[c].count > 0) {
         on_drop(c, pending_[c].at(0));
         pending_[c].erase(0);
@@ -137,13 +164,28 @@ class FramePairer {
   };
 
   explicit FramePairer(const PairerConfig& config) : config_(config) {
-    for (Queue& q : pending_) q.items.resize(config.max_pending);
+    for (int c = 0; c < config.cameras; ++c) pending_[c].items.resize(config.max_pending);
+  }
+
+  // Index of camera c's pending entry closest to `key` within tolerance; count: none.
+  std::uint32_t closest(int c, std::int64_t key) const noexcept {
+    const Queue& q = pending_[c];
+    std::uint32_t best = q.count;
+    std::int64_t best_dk = 0;
+    for (std::uint32_t i = 0; i < q.count; ++i) {
+      const std::int64_t dk = std::llabs(q.at(i).key - key);
+      if (dk <= config_.tolerance && (best == q.count || dk < best_dk)) {
+        best = i;
+        best_dk = dk;
+      }
+    }
+    return best;
   }
 
   PairerConfig config_;
-  Queue pending_[2];
-  std::int64_t latest_[2] = {0, 0};
-  bool has_latest_[2] = {false, false};
+  Queue pending_[kMaxCameras];
+  std::int64_t latest_[kMaxCameras] = {};
+  bool has_latest_[kMaxCameras] = {};
   PairerCounters counters_;
 };
 

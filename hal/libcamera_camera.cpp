@@ -17,7 +17,7 @@
 #include <cstring>
 #include <mutex>
 
-#include "hal/rt/spsc_ring.h"
+#include "rt/spsc_ring.h"
 
 namespace mocap::hal {
 

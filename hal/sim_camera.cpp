@@ -35,19 +35,25 @@ Expected<std::shared_ptr<const SimFrameLoop>> SimFrameLoop::render(const sim::Si
   const sim::SimScene& sc = loop->scene_;
   const auto n = static_cast<std::size_t>(options.frames);
   loop->states_.reserve(n);
-  loop->images_.reserve(n * 2);
+  const int cams = static_cast<int>(sc.rig.cameras.size());
+  loop->cameras_ = cams;
+  loop->images_.reserve(n * static_cast<std::size_t>(cams));
   for (std::size_t f = 0; f < n; ++f) {
     sim::SceneState st = sim::make_state(sc);
     sim::apply_config(sc, plan->configs[f], st);
     st.noise_key = sim::frame_noise_key(options.seed, static_cast<std::int64_t>(f));
     loop->states_.push_back(std::move(st));
-    for (int c = 0; c < 2; ++c) loop->images_.push_back(sim::make_camera_image(sc, c));
   }
-  auto stereo = sim::StereoRender::create(sc, options.threads);
-  if (!stereo) return stereo.error();
+  auto render = sim::MultiRender::create(sc, options.threads);
+  if (!render) return render.error();
+  std::vector<Image> frame_images = sim::make_camera_images(sc);  // every camera of one frame
   for (std::size_t f = 0; f < n; ++f) {
-    if (!stereo->render(loop->states_[f], {&loop->images_[f * 2], &loop->images_[f * 2 + 1]}))
+    if (!render->render(loop->states_[f], frame_images))
       return make_error("sim camera", "render", "rendering a loop frame failed");
+    for (int c = 0; c < cams; ++c) {
+      loop->images_.push_back(sim::make_camera_image(sc, c));
+      std::swap(loop->images_.back(), frame_images[static_cast<std::size_t>(c)]);
+    }
   }
   return std::shared_ptr<const SimFrameLoop>(std::move(loop));
 }
@@ -87,9 +93,11 @@ bool SimTrigger::timestamp_of(std::uint64_t s, std::int64_t& timestamp_ns) const
 Expected<std::unique_ptr<SimCamera>> SimCamera::open(std::shared_ptr<SimTrigger> trigger,
                                                      int camera_index) {
   if (!trigger) return make_error("sim camera", "", "no trigger");
-  if (camera_index < 0 || camera_index > 1) {
-    return make_error("sim camera", "camera",
-                      "index " + std::to_string(camera_index) + " outside 0..1");
+  const int cams = trigger->loop().cameras();
+  if (camera_index < 0 || camera_index >= cams) {
+    return make_error(
+        "sim camera", "camera",
+        "index " + std::to_string(camera_index) + " outside 0.." + std::to_string(cams - 1));
   }
   return std::unique_ptr<SimCamera>(new SimCamera(std::move(trigger), camera_index));
 }

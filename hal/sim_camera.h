@@ -1,13 +1,14 @@
 // Design: the simulated backend of the Camera interface, so that the live pipeline
 // runs end to end without hardware (`mocap run` with no configuration).
 //   SimFrameLoop : setup only. Renders `frames` frames of the built-in scenario (the
-//                  simulator's motion, both cameras) into owned Images, once. Memory:
-//                  frames x 2 x width x height bytes, e.g. 200 x 2 x 1032 x 776 = 320 MB
-//                  (8-bit); tests use short loops. Immutable afterwards, shared.
-//   SimTrigger   : the shared trigger line of the stereo pair. trigger() stamps the
+//                  simulator's motion, every camera of the scene: 2..8) into owned
+//                  Images, once. Memory: frames x cameras x width x height bytes, e.g.
+//                  200 x 2 x 1032 x 776 = 320 MB (8-bit); tests use short loops.
+//                  Immutable afterwards, shared.
+//   SimTrigger   : the shared trigger line of the rig's cameras. trigger() stamps the
 //                  next sequence number with CLOCK_MONOTONIC (one writer); cameras read
 //                  the stamps lock-free from a small ring of atomics.
-//   SimCamera    : one camera of the pair. Trigger modes: kSoftware (this camera's
+//   SimCamera    : one camera of the rig. Trigger modes: kSoftware (this camera's
 //                  trigger() fires the shared line: the master), kExternal (slaved to
 //                  the shared line, trigger() is kUnsupported), kFreeRun (frames at
 //                  frame_rate_hz from start(), own sequence). Sequence s shows loop
@@ -43,8 +44,10 @@ class SimFrameLoop {
   const sim::SimScene& scene() const noexcept { return scene_; }
   int frames() const noexcept { return static_cast<int>(states_.size()); }
   double fps() const noexcept { return fps_; }
+  int cameras() const noexcept { return cameras_; }
   const Image& image(int frame, int camera) const noexcept {
-    return images_[static_cast<std::size_t>(frame) * 2 + static_cast<std::size_t>(camera)];
+    return images_[static_cast<std::size_t>(frame) * static_cast<std::size_t>(cameras_) +
+                   static_cast<std::size_t>(camera)];
   }
   // The true body poses of a loop frame (ground truth for tests).
   const sim::SceneState& state(int frame) const noexcept {
@@ -58,7 +61,8 @@ class SimFrameLoop {
   SimFrameLoop() = default;
   sim::SimScene scene_;
   std::vector<sim::SceneState> states_;
-  std::vector<Image> images_;  // frame-major: [frame * 2 + camera]
+  std::vector<Image> images_;  // frame-major: [frame * cameras_ + camera]
+  int cameras_ = 2;
   double fps_ = 100.0;
 };
 
@@ -98,7 +102,7 @@ class SimCamera final : public CameraBase {
   CameraStatus release(const Frame& frame) noexcept override;
 
   // The scene camera's size, 8-bit, software trigger for camera 0 and external
-  // (slaved) for camera 1, at the loop's frame rate.
+  // (slaved) for every other camera, at the loop's frame rate.
   CameraConfig native_config() const;
 
  private:

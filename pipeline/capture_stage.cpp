@@ -1,6 +1,6 @@
 // Design: see pipeline.h. The capture stage (hot path: noexcept, allocation-free,
 // lock-free, no logging; its counters have this thread as their only writer): fires the
-// software triggers on their grid, dequeues both cameras without ever waiting on a
+// software triggers on their grid, dequeues every camera without ever waiting on a
 // stalled one past the next trigger, counts each camera's clock steps (timestamp_check.h;
 // the frame goes on unchanged), hands each frame to its detector (dropping it when the
 // detector holds every slot) and releases the buffers the detectors give back.
@@ -11,7 +11,7 @@
 namespace mocap::pipeline {
 
 void Pipeline::release_returned() noexcept {
-  for (int c = 0; c < 2; ++c) {
+  for (int c = 0; c < camera_count(); ++c) {
     hal::Frame f;
     while (returned_[static_cast<std::size_t>(c)]->try_pop(f)) {
       if (cameras_[static_cast<std::size_t>(c)]->release(f) != hal::CameraStatus::kOk)
@@ -23,13 +23,17 @@ void Pipeline::release_returned() noexcept {
 void Pipeline::capture_loop() noexcept {
   if (options_.hooks) options_.hooks->on_loop_start(StageId::kCapture);
   Counters& k = *counters_;
-  bool software[2];
-  for (int c = 0; c < 2; ++c)
+  const int cams = camera_count();
+  bool software[kMaxCameras] = {};
+  bool triggered_mode = false;
+  for (int c = 0; c < cams; ++c) {
     software[c] =
         cameras_[static_cast<std::size_t>(c)]->config().trigger == hal::TriggerMode::kSoftware;
-  const bool triggered_mode = software[0] || software[1];
+    triggered_mode = triggered_mode || software[c];
+  }
   const auto period_ns = static_cast<std::int64_t>(1e9 / options_.trigger_rate_hz);
-  for (std::size_t c = 0; c < 2; ++c) {  // frame period of each camera's timestamps
+  for (std::size_t c = 0; c < static_cast<std::size_t>(cams);
+       ++c) {  // frame period of each camera's timestamps
     const double free_rate_hz = cameras_[c]->config().frame_rate_hz;
     clock_checks_[c] = TimestampCheck(
         !triggered_mode && free_rate_hz > 0.0
@@ -62,7 +66,7 @@ void Pipeline::capture_loop() noexcept {
         k.trigger_overruns.add(static_cast<std::uint64_t>((now - next_trigger_ns) / period_ns) + 1);
         next_trigger_ns = now + period_ns;
       }
-      for (int c = 0; c < 2; ++c) {
+      for (int c = 0; c < cams; ++c) {
         if (software[c] &&
             cameras_[static_cast<std::size_t>(c)]->trigger() != hal::CameraStatus::kOk)
           k.trigger_errors.add();
@@ -71,13 +75,13 @@ void Pipeline::capture_loop() noexcept {
       k.triggered.add();
     }
     // Wait for each camera's frame at most dequeue_timeout_ms and never past the next
-    // trigger (a stalled camera must not delay the other one or the trigger), then drain
+    // trigger (a stalled camera must not delay the others or the trigger), then drain
     // whatever else is ready (a camera that caught up after a stall).
     std::uint64_t last_sequence = 0;
     bool pushed = false;
-    for (int c = 0; c < 2; ++c) {
+    for (int c = 0; c < cams; ++c) {
       hal::Camera& cam = *cameras_[static_cast<std::size_t>(c)];
-      int timeout_ms = 5;  // free-run: the two cameras are polled in turn
+      int timeout_ms = 5;  // free-run: the cameras are polled in turn
       if (triggered_mode) {
         const std::int64_t left_ns = next_trigger_ns - monotonic_ns();
         const std::int64_t left_ms = (left_ns + 999'999) / 1'000'000;  // round up
@@ -106,7 +110,7 @@ void Pipeline::capture_loop() noexcept {
         last_sequence = f.sequence;
         if (to_detect_[static_cast<std::size_t>(c)]->try_push(f)) {
           pushed = true;
-          bells_[index(StageId::kDetect0) + static_cast<std::size_t>(c)].ring();
+          bells_[index(StageId::detect(c))].ring();
         } else {  // the detector holds every slot (stalled): drop this frame
           k.capture_ring_full[c].add();
           if (cam.release(f) != hal::CameraStatus::kOk) k.release_errors.add();

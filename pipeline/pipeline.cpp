@@ -2,9 +2,13 @@
 // options, start() allocates every ring and slot and starts the cameras and the five
 // threads, stop() joins them and returns every buffer; retire()/finished() keep the
 // count of sequences the pipeline is done with. Setup may allocate and fails with
-// one-line errors. The stage loops (the hot path) are in capture_stage.cpp and
-// processing_stages.cpp, the reports (health(), stats()) in pipeline_stats.cpp.
+// one-line errors. The threads' settings come from the stage table (resolve_stage(): the
+// detect rule per camera) and are fixed at create(). The stage loops (the hot path) are in
+// capture_stage.cpp and processing_stages.cpp, the reports (health(), stats()) in
+// pipeline_stats.cpp.
 #include "pipeline/pipeline.h"
+
+#include <unistd.h>
 
 #include <algorithm>
 #include <utility>
@@ -12,10 +16,21 @@
 namespace mocap::pipeline {
 
 Expected<std::unique_ptr<Pipeline>> Pipeline::create(FrameProcessor processor,
-                                                     std::array<hal::Camera*, 2> cameras,
+                                                     std::vector<hal::Camera*> cameras,
                                                      std::vector<publish::OutputSink*> sinks,
                                                      const PipelineOptions& options) {
-  for (int c = 0; c < 2; ++c) {
+  const int n = static_cast<int>(cameras.size());
+  if (n < kMinCameras || n > kMaxCameras) {
+    return make_error("pipeline", "cameras",
+                      std::to_string(n) + " cameras, expected " + std::to_string(kMinCameras) +
+                          ".." + std::to_string(kMaxCameras));
+  }
+  if (n != processor.camera_count()) {
+    return make_error(
+        "pipeline", "cameras",
+        std::to_string(n) + " cameras, the rig has " + std::to_string(processor.camera_count()));
+  }
+  for (int c = 0; c < n; ++c) {
     if (cameras[static_cast<std::size_t>(c)] == nullptr)
       return make_error("pipeline", "cameras", "camera " + std::to_string(c) + " is missing");
   }
@@ -35,25 +50,30 @@ Expected<std::unique_ptr<Pipeline>> Pipeline::create(FrameProcessor processor,
     return make_error("pipeline", "pair_tolerance_us",
                       "must be in 1..1000000 us, got " + std::to_string(options.pair_tolerance_us));
   }
-  for (const StageSpec& s : options.stages) {
+  const long online = sysconf(_SC_NPROCESSORS_ONLN);
+  const int cpus = options.cpu_count > 0 ? options.cpu_count
+                                         : static_cast<int>(std::clamp<long>(online, 1, 1024));
+  std::unique_ptr<Pipeline> p(
+      new Pipeline(std::move(processor), std::move(cameras), std::move(sinks), options));
+  std::vector<StageId> ids = {StageId::kCapture, StageId::kIdentify, StageId::kPublish};
+  for (int c = 0; c < n; ++c) ids.push_back(StageId::detect(c));
+  for (StageId id : ids) {
+    ResolvedStage& s = p->plan_[index(id)];
+    s = resolve_stage(options.stages, id, cpus);
     if (auto v = rt::validate(rt::ThreadSpec{s.name, s.cpu, s.fifo_priority}); !v)
-      return make_error("pipeline", std::string("stages: ") + s.name, v.error().message);
-  }
-  for (std::size_t i = 1; i < kStageCount; ++i) {
-    const StageSpec& s = options.stages[i];
-    if (s.ring_depth < 2 || s.ring_depth > 1024) {
-      return make_error("pipeline", std::string("stages: ") + s.name + ": ring_depth",
+      return make_error("pipeline", "stages: " + s.name, v.error().message);
+    if (id.kind != StageKind::kCapture && (s.ring_depth < 2 || s.ring_depth > 1024)) {
+      return make_error("pipeline", "stages: " + s.name + ": ring_depth",
                         "must be in 2..1024, got " + std::to_string(s.ring_depth));
     }
   }
-  return std::unique_ptr<Pipeline>(
-      new Pipeline(std::move(processor), cameras, std::move(sinks), options));
+  return p;
 }
 
-Pipeline::Pipeline(FrameProcessor processor, std::array<hal::Camera*, 2> cameras,
+Pipeline::Pipeline(FrameProcessor processor, std::vector<hal::Camera*> cameras,
                    std::vector<publish::OutputSink*> sinks, const PipelineOptions& options)
     : processor_(std::move(processor)),
-      cameras_(cameras),
+      cameras_(std::move(cameras)),
       sinks_(std::move(sinks)),
       options_(options) {}
 
@@ -62,11 +82,11 @@ Pipeline::~Pipeline() { stop(); }
 Expected<void> Pipeline::start() {
   if (running_) return make_error("pipeline", "start", "already running");
   notes_.clear();
+  const int n = camera_count();
   // Camera buffers: the detect ring, one in the detector's hand, one on its way back.
-  for (int c = 0; c < 2; ++c) {
+  for (int c = 0; c < n; ++c) {
     hal::Camera& cam = *cameras_[static_cast<std::size_t>(c)];
-    const std::uint32_t depth =
-        options_.stages[index(StageId::kDetect0) + static_cast<std::size_t>(c)].ring_depth;
+    const std::uint32_t depth = stage(StageId::detect(c)).ring_depth;
     if (cam.config().buffer_count < static_cast<int>(depth) + 2) {
       return make_error(
           cam.name(), "buffer_count",
@@ -77,33 +97,31 @@ Expected<void> Pipeline::start() {
   to_detect_.clear();
   returned_.clear();
   blob_pools_.clear();
-  for (int c = 0; c < 2; ++c) {
+  for (int c = 0; c < n; ++c) {
     hal::Camera& cam = *cameras_[static_cast<std::size_t>(c)];
-    const std::uint32_t depth =
-        options_.stages[index(StageId::kDetect0) + static_cast<std::size_t>(c)].ring_depth;
+    const std::uint32_t depth = stage(StageId::detect(c)).ring_depth;
     to_detect_.push_back(
         std::make_unique<rt::SpscRing<hal::Frame>>(rt::next_power_of_two_at_least(depth)));
     returned_.push_back(std::make_unique<rt::SpscRing<hal::Frame>>(
         rt::next_power_of_two_at_least(static_cast<std::size_t>(cam.config().buffer_count))));
     const FrameOutput proto = processor_.make_output();
-    auto pool = rt::SlotPool<BlobSlot>::create(
-        options_.stages[index(StageId::kIdentify)].ring_depth + 2, [&](std::uint32_t) {
-          BlobSlot s;
-          s.blobs = proto.blobs[static_cast<std::size_t>(c)];
-          return s;
-        });
+    auto pool = rt::SlotPool<BlobSlot>::create(stage(StageId::kIdentify).ring_depth + 2,
+                                               [&](std::uint32_t) {
+                                                 BlobSlot s;
+                                                 s.blobs = proto.blobs[static_cast<std::size_t>(c)];
+                                                 return s;
+                                               });
     if (!pool) return pool.error();
     blob_pools_.push_back(std::make_unique<rt::SlotPool<BlobSlot>>(std::move(pool).value()));
   }
-  auto msg_pool =
-      rt::SlotPool<MsgSlot>::create(options_.stages[index(StageId::kPublish)].ring_depth + 2,
-                                    [](std::uint32_t) { return MsgSlot{}; });
+  auto msg_pool = rt::SlotPool<MsgSlot>::create(stage(StageId::kPublish).ring_depth + 2,
+                                                [](std::uint32_t) { return MsgSlot{}; });
   if (!msg_pool) return msg_pool.error();
   msg_pool_ = std::make_unique<rt::SlotPool<MsgSlot>>(std::move(msg_pool).value());
   const std::int64_t tolerance =
       options_.pair_by == PairBy::kTimestamp ? options_.pair_tolerance_us * 1000 : 0;
   auto pairer = hal::FramePairer::create(
-      hal::PairerConfig{tolerance, options_.stages[index(StageId::kIdentify)].ring_depth});
+      hal::PairerConfig{tolerance, stage(StageId::kIdentify).ring_depth, n});
   if (!pairer) return pairer.error();
   pairer_ = std::make_unique<hal::FramePairer>(std::move(pairer).value());
   out_ = std::make_unique<FrameOutput>(processor_.make_output());
@@ -122,9 +140,10 @@ Expected<void> Pipeline::start() {
   if (options_.lock_memory) {
     if (std::string note = rt::lock_memory(); !note.empty()) notes_.push_back(note);
   }
-  for (int c = 0; c < 2; ++c) {
+  for (int c = 0; c < n; ++c) {
     if (auto r = cameras_[static_cast<std::size_t>(c)]->start(); !r) {
-      if (c == 1) cameras_[0]->stop();
+      for (int started = 0; started < c; ++started)
+        cameras_[static_cast<std::size_t>(started)]->stop();
       return r.error();
     }
   }
@@ -133,27 +152,25 @@ Expected<void> Pipeline::start() {
   for (auto& t : last_frame_ns_) t.store(0, std::memory_order_relaxed);  // no frame yet
   threads_.clear();
   // Consumers first, so that no producer ever runs ahead of a missing consumer.
-  const StageId order[] = {StageId::kPublish, StageId::kIdentify, StageId::kDetect0,
-                           StageId::kDetect1, StageId::kCapture};
+  std::vector<StageId> order = {StageId::kPublish, StageId::kIdentify};
+  for (int c = 0; c < n; ++c) order.push_back(StageId::detect(c));
+  order.push_back(StageId::kCapture);
   for (StageId id : order) {
-    const StageSpec& s = options_.stages[index(id)];
+    const ResolvedStage& s = stage(id);
     rt::ThreadSpec spec{s.name, options_.realtime ? s.cpu : -1,
                         options_.realtime ? s.fifo_priority : 0};
     std::function<void()> body;
-    switch (id) {
-      case StageId::kCapture:
+    switch (id.kind) {
+      case StageKind::kCapture:
         body = [this] { capture_loop(); };
         break;
-      case StageId::kDetect0:
-        body = [this] { detect_loop(0); };
+      case StageKind::kDetect:
+        body = [this, c = id.camera] { detect_loop(c); };
         break;
-      case StageId::kDetect1:
-        body = [this] { detect_loop(1); };
-        break;
-      case StageId::kIdentify:
+      case StageKind::kIdentify:
         body = [this] { identify_loop(); };
         break;
-      case StageId::kPublish:
+      case StageKind::kPublish:
         body = [this] { publish_loop(); };
         break;
     }
@@ -188,7 +205,7 @@ void Pipeline::stop() noexcept {
 
 void Pipeline::drain_after_join() noexcept {
   // Every thread is joined: this thread now owns every ring end.
-  for (int c = 0; c < 2; ++c) {
+  for (int c = 0; c < camera_count(); ++c) {
     hal::Frame f;
     while (to_detect_[static_cast<std::size_t>(c)]->try_pop(f))
       cameras_[static_cast<std::size_t>(c)]->release(f);

@@ -1,10 +1,11 @@
-// Design: the live real-time pipeline: five pinned threads (stage_table.h) passing
-// preallocated buffers through lock-free SPSC rings.
+// Design: the live real-time pipeline over the rig's 2..kMaxCameras cameras: capture,
+// one detect thread per camera, identify and publish, pinned from the one stage table
+// (stage_table.h), passing preallocated buffers through lock-free SPSC rings.
 //
 //   capture --Frame ring[c]--> detect c --blob slot pool[c]--> identify --result pool--> publish
-//      ^                          |                             (pair by sequence,  (OutputSinks)
-//      +------ return ring[c] ----+ (camera buffer back          stereo, identify,
-//                                    right after detection)      angles)
+//      ^                          |                          (match by sequence,  (OutputSinks)
+//      +------ return ring[c] ----+ (camera buffer back       pairs + N-view merge,
+//                                    right after detection)   identify, angles)
 //
 // Ownership: a camera buffer (Frame) belongs to the capture thread, which alone calls
 // release(); a detector hands every Frame back through its return ring. Blob slots and
@@ -13,8 +14,8 @@
 // Drop policy (the capture never blocks): each consumer drains its input and works on
 // the NEWEST item, returning the older ones (counted as skipped); a producer whose
 // consumer has stalled long enough to hold every slot drops the incoming item (counted).
-// Pairing: hal::FramePairer by trigger sequence (tolerance 0) or, for free-running
-// cameras, by sensor timestamp within PipelineOptions::pair_tolerance_us (unmatched
+// Matching: hal::FramePairer (one frame of every camera) by trigger sequence (tolerance 0) or, for
+// free-running cameras, by sensor timestamp within PipelineOptions::pair_tolerance_us (unmatched
 // frames counted).
 // Latency: every sample is measured from the frame's trigger timestamp (Frame.timestamp_ns)
 // on CLOCK_MONOTONIC: detect done, identify done, published (end to end), into
@@ -32,14 +33,11 @@
 #include <utility>
 #include <vector>
 
+#include "core/camera_set.h"
 #include "core/expected.h"
 #include "core/latency_stats.h"
 #include "hal/camera.h"
 #include "hal/frame_pairer.h"
-#include "hal/rt/counter.h"
-#include "hal/rt/slot_pool.h"
-#include "hal/rt/spsc_ring.h"
-#include "hal/rt/thread.h"
 #include "pipeline/doorbell.h"
 #include "pipeline/frame_result_builder.h"
 #include "pipeline/latency_histogram.h"
@@ -47,6 +45,10 @@
 #include "pipeline/stage_counters.h"
 #include "pipeline/stage_table.h"
 #include "pipeline/timestamp_check.h"
+#include "rt/counter.h"
+#include "rt/slot_pool.h"
+#include "rt/spsc_ring.h"
+#include "rt/thread.h"
 #include "track/frame_processor.h"
 
 namespace mocap::pipeline {
@@ -91,7 +93,8 @@ class StageHooks {
 };
 
 struct PipelineOptions {
-  std::array<StageSpec, kStageCount> stages = kDefaultStages;
+  StageTable stages{};             // the rule per stage kind + per-camera detect overrides
+  int cpu_count = 0;               // CPUs the detect rule spreads over; 0: this machine's (online)
   bool realtime = true;            // apply the table's CPU pinning and SCHED_FIFO (fallback noted)
   bool lock_memory = true;         // mlockall (fallback noted)
   double trigger_rate_hz = 100.0;  // software-triggered cameras
@@ -120,13 +123,15 @@ struct PipelineHealth {
   double fps = 0.0;     // publish rate over the last ~16 frames; 0 after 1 s without one
   double p99_us = 0.0;  // trigger-to-publish p99 since start()
   double max_us = 0.0;  // trigger-to-publish max since start()
-  std::int64_t last_publish_ns = 0;           // CLOCK_MONOTONIC; 0: nothing published yet
-  std::int64_t camera_silent_ms[2] = {0, 0};  // time since camera c last delivered a frame
+  std::int64_t last_publish_ns = 0;  // CLOCK_MONOTONIC; 0: nothing published yet
+  int camera_count = 0;              // entries [0, camera_count) of the arrays below
+  // Per camera: time since camera c last delivered a frame.
+  std::array<std::int64_t, kMaxCameras> camera_silent_ms{};
   // Per camera: frames whose blobs did not all fit (an image full of blobs: the detector's
   // run or blob capacity overflowed; detect_camN_frames_overflow) and camera clock steps
   // (timestamp_backwards_camN + timestamp_jumps_camN).
-  std::uint64_t detect_overflow_frames[2] = {0, 0};
-  std::uint64_t timestamp_steps[2] = {0, 0};
+  std::array<std::uint64_t, kMaxCameras> detect_overflow_frames{};
+  std::array<std::uint64_t, kMaxCameras> timestamp_steps{};
   // Summed over the output sinks (OutputCounters): frames a transport refused, and frames
   // a slow sink's drop-oldest queue dropped.
   std::uint64_t output_failures = 0;
@@ -138,7 +143,7 @@ struct PipelineStats {
   std::uint64_t triggered = 0;
   std::uint64_t published = 0;
   double fps = 0.0;  // published / duration
-  // (name, summary): detect0/detect1/identify/publish are latencies from the trigger
+  // (name, summary): detect<k>/identify/publish are latencies from the trigger
   // ("publish" is trigger-to-publish, end to end); *_work are the stage's own times.
   std::vector<std::pair<std::string, LatencyStats>> latency;
   std::vector<std::pair<std::string, std::uint64_t>> counters;
@@ -146,17 +151,18 @@ struct PipelineStats {
 
 class Pipeline {
  public:
-  // `cameras` are configured but not started (the pipeline starts and stops them and
-  // drives them from its capture thread); sinks and cameras must outlive the pipeline.
+  // `cameras` (2..kMaxCameras, in rig order: as many as the processor's rig has) are
+  // configured but not started (the pipeline starts and stops them and drives them from
+  // its capture thread); sinks and cameras must outlive the pipeline.
   static Expected<std::unique_ptr<Pipeline>> create(FrameProcessor processor,
-                                                    std::array<hal::Camera*, 2> cameras,
+                                                    std::vector<hal::Camera*> cameras,
                                                     std::vector<publish::OutputSink*> sinks,
                                                     const PipelineOptions& options);
   ~Pipeline();
   Pipeline(const Pipeline&) = delete;
   Pipeline& operator=(const Pipeline&) = delete;
 
-  // Allocates every ring and slot, starts the cameras and the five threads. The
+  // Allocates every ring and slot, starts the cameras and the 3 + cameras threads. The
   // fallbacks taken (no SCHED_FIFO, no mlockall, no pinning) are in notes().
   Expected<void> start();
   // Stops triggering, joins every thread (each wakes within ~20 ms), returns every
@@ -187,6 +193,9 @@ class Pipeline {
   // The trigger-to-publish histogram (any thread; periodic interval reports).
   const LatencyHistogram* end_to_end() const noexcept { return lat_ ? &lat_->publish : nullptr; }
   const FrameProcessor& processor() const noexcept { return processor_; }
+  int camera_count() const noexcept { return static_cast<int>(cameras_.size()); }
+  // The resolved stage of thread `id` (stage table rule and overrides applied).
+  const ResolvedStage& stage(StageId id) const noexcept { return plan_[index(id)]; }
 
  private:
   struct BlobSlot {
@@ -199,14 +208,14 @@ class Pipeline {
     publish::FrameResult frame;  // the frame's whole result, for every output sink
   };
   struct Counters {
-    rt::Counter triggered, trigger_errors, dequeue_timeouts[2], dequeue_errors;
+    rt::Counter triggered, trigger_errors, dequeue_timeouts[kMaxCameras], dequeue_errors;
     rt::Counter trigger_overruns;     // trigger periods skipped (capture late by >= 1 period)
     rt::Counter trigger_late_max_us;  // latest trigger vs its deadline
-    rt::Counter capture_ring_full[2], release_errors;
-    rt::Counter camera_max_silence_us[2];  // longest interval without a frame (a stall)
+    rt::Counter capture_ring_full[kMaxCameras], release_errors;
+    rt::Counter camera_max_silence_us[kMaxCameras];  // longest interval without a frame
     // Camera clock steps (TimestampCheck verdicts), capture thread.
-    rt::Counter timestamp_backwards[2], timestamp_jumps[2];
-    rt::Counter detect_skipped[2], detect_no_slot[2];
+    rt::Counter timestamp_backwards[kMaxCameras], timestamp_jumps[kMaxCameras];
+    rt::Counter detect_skipped[kMaxCameras], detect_no_slot[kMaxCameras];
     rt::Counter frames_unpaired;  // sequences that never formed a pair (identify)
     rt::Counter identify_skipped, identify_no_slot;
     rt::Counter frames_without_result;  // processed, but not every body found
@@ -217,7 +226,7 @@ class Pipeline {
       DetectorMirror detector;
       rt::Counter blobs;  // blobs handed to identify
     };
-    DetectLibrary detect_library[2];
+    DetectLibrary detect_library[kMaxCameras];
     struct alignas(64) IdentifyLibrary {  // identify
       StereoMirror stereo;
       IdentifyMirror identify;
@@ -227,14 +236,15 @@ class Pipeline {
     IdentifyLibrary identify_library;
   };
   struct Latencies {
-    LatencyHistogram detect[2], detect_work[2], identify, identify_work, publish, sink_work;
+    LatencyHistogram detect[kMaxCameras], detect_work[kMaxCameras];
+    LatencyHistogram identify, identify_work, publish, sink_work;
     std::unique_ptr<LatencyHistogram[]> sink_work_each;  // one per sink, in sinks_ order
   };
 
   static constexpr std::int64_t kIdleWaitNs = 10'000'000;  // stages re-check stop this often
   static constexpr std::int64_t kLockstepTimeoutNs = 1'000'000'000;
 
-  Pipeline(FrameProcessor processor, std::array<hal::Camera*, 2> cameras,
+  Pipeline(FrameProcessor processor, std::vector<hal::Camera*> cameras,
            std::vector<publish::OutputSink*> sinks, const PipelineOptions& options);
 
   // The stage loops (capture_stage.cpp, processing_stages.cpp).
@@ -250,9 +260,10 @@ class Pipeline {
   void drain_after_join() noexcept;
 
   FrameProcessor processor_;
-  std::array<hal::Camera*, 2> cameras_;
+  std::vector<hal::Camera*> cameras_;  // 2..kMaxCameras, fixed at create()
   std::vector<publish::OutputSink*> sinks_;
   PipelineOptions options_;
+  std::array<ResolvedStage, kMaxStages> plan_{};  // per thread (index()), at create()
   std::vector<std::string> notes_;
   bool running_ = false;
 
@@ -264,8 +275,8 @@ class Pipeline {
   std::unique_ptr<FrameOutput> out_;
   std::unique_ptr<Counters> counters_;
   std::unique_ptr<Latencies> lat_;
-  std::array<TimestampCheck, 2> clock_checks_{};  // capture thread (set as its loop starts)
-  std::array<Doorbell, kStageCount> bells_{};
+  std::array<TimestampCheck, kMaxCameras> clock_checks_{};  // capture thread (set at loop start)
+  std::array<Doorbell, kMaxStages> bells_{};
   std::vector<rt::RtThread> threads_;
   std::int64_t start_ns_ = 0, stop_ns_ = 0;
 
@@ -273,8 +284,8 @@ class Pipeline {
   std::atomic<bool> triggering_done_{false};
   std::atomic<std::uint64_t> published_{0};
   std::atomic<std::int64_t> last_publish_ns_{0};
-  std::atomic<std::int64_t> publish_period_ns_{0};   // EMA, publish thread writes
-  std::atomic<std::int64_t> last_frame_ns_[2] = {};  // capture thread writes
+  std::atomic<std::int64_t> publish_period_ns_{0};             // EMA, publish thread writes
+  std::atomic<std::int64_t> last_frame_ns_[kMaxCameras] = {};  // capture thread writes
   // First sequence the capture thread dequeued (+1; 0: none yet): the start of the gaps.
   std::atomic<std::uint64_t> first_sequence_{0};
   // Highest sequence the identify/publish path has finished with (+1; 0: none).

@@ -1,7 +1,8 @@
 // Design: see pipeline.h. The processing stages after the capture (hot path: noexcept,
 // allocation-free, lock-free, no logging; each counter has one writer thread):
 //   detect c : the newest frame of camera c -> its blobs in a blob slot (drop-oldest);
-//   identify : pairs the two cameras' blob slots, then stereo + identification + angles
+//   identify : matches every camera's blob slot of a sequence (hal::FramePairer), then
+//              pairs + N-view merge + identification + angles
 //              (FrameProcessor::process_blobs) into a message slot (drop-oldest pairs);
 //   publish  : the newest message to every sink, then the sequence is retired.
 #include <utility>
@@ -11,7 +12,7 @@
 namespace mocap::pipeline {
 
 void Pipeline::detect_loop(int camera) noexcept {
-  const StageId id = camera == 0 ? StageId::kDetect0 : StageId::kDetect1;
+  const StageId id = StageId::detect(camera);
   if (options_.hooks) options_.hooks->on_loop_start(id);
   const auto c = static_cast<std::size_t>(camera);
   rt::SpscRing<hal::Frame>& in = *to_detect_[c];
@@ -94,9 +95,14 @@ void Pipeline::identify_loop() noexcept {
       next_sequence = sequence + 1;
     }
   };
+  const int n = camera_count();
+  auto release_set = [&](const hal::FramePair& set) {  // every camera's slot of a set
+    for (int c = 0; c < n; ++c)
+      blob_pools_[static_cast<std::size_t>(c)]->release(set.cam[c].handle);
+  };
   while (!stopping()) {
     const std::uint32_t seen = bell.snapshot();
-    for (int c = 0; c < 2; ++c) {
+    for (int c = 0; c < n; ++c) {
       rt::SlotPool<BlobSlot>& pool = *blob_pools_[static_cast<std::size_t>(c)];
       rt::SlotHandle h;
       while (pool.pop(h)) {
@@ -106,10 +112,11 @@ void Pipeline::identify_loop() noexcept {
         const hal::PairEntry e{key, h};
         if (!pairer.push(c, e, p, on_drop)) continue;
         count_unpaired((*blob_pools_[0])[p.cam[0].handle].sequence);
-        if (have_pair) {  // drop-oldest: a newer pair is complete
+        if (have_pair) {  // drop-oldest: a newer set is complete
           k.identify_skipped.add();
-          on_drop(0, pair.cam[0]);
-          blob_pools_[1]->release(pair.cam[1].handle);
+          const std::uint64_t dropped = (*blob_pools_[0])[pair.cam[0].handle].sequence;
+          release_set(pair);
+          retire(dropped);
         }
         pair = p;
         have_pair = true;
@@ -121,16 +128,16 @@ void Pipeline::identify_loop() noexcept {
     }
     have_pair = false;
     const std::int64_t t0 = monotonic_ns();
-    BlobSlot* slots[2] = {&(*blob_pools_[0])[pair.cam[0].handle],
-                          &(*blob_pools_[1])[pair.cam[1].handle]};
-    for (std::size_t c = 0; c < 2; ++c) {
-      std::swap(out.blobs[c], slots[c]->blobs);  // O(1), same capacities: no allocation
-      out.camera_present[c] = slots[c]->present;
+    for (int c = 0; c < n; ++c) {
+      const auto ci = static_cast<std::size_t>(c);
+      BlobSlot& slot = (*blob_pools_[ci])[pair.cam[c].handle];
+      std::swap(out.blobs[ci], slot.blobs);  // O(1), same capacities: no allocation
+      out.camera_present[ci] = slot.present;
     }
-    const std::uint64_t sequence = slots[0]->sequence;
-    const std::int64_t capture_ns = slots[0]->capture_ns;
-    blob_pools_[0]->release(pair.cam[0].handle);
-    blob_pools_[1]->release(pair.cam[1].handle);
+    const BlobSlot& first = (*blob_pools_[0])[pair.cam[0].handle];
+    const std::uint64_t sequence = first.sequence;
+    const std::int64_t capture_ns = first.capture_ns;
+    release_set(pair);
     processor_.process_blobs(capture_ns, out);
     k.identify_library.stereo.publish(kStereoFields, processor_.stereo_counters());
     k.identify_library.identify.publish(kIdentifyFields, processor_.identify_counters());

@@ -31,7 +31,8 @@ std::vector<JointCoverage> coverage_of(const PipelineStats& s) {
     c.joint = name.substr(prefix.size(), name.size() - prefix.size() - poses.size());
     c.poses = static_cast<double>(v) / static_cast<double>(frames);
     for (const auto& [n2, v2] : s.counters)
-      if (n2 == prefix + c.joint + "_chain") c.chain = static_cast<double>(v2) / static_cast<double>(frames);
+      if (n2 == prefix + c.joint + "_chain")
+        c.chain = static_cast<double>(v2) / static_cast<double>(frames);
     out.push_back(c);
   }
   return out;
@@ -76,22 +77,30 @@ std::string format_pipeline_stats(const PipelineStats& s) {
 
 std::string format_progress_line(double elapsed_s, double interval_s, const LatencyStats& e2e,
                                  const PipelineHealth& h) {
-  char line[400];
-  std::snprintf(
-      line, sizeof line,
-      "t=%.1fs fps=%.1f e2e(last %.1fs, %llu) p50=%.0f p99=%.0f p99.9=%.0f max=%.0f us "
-      "published=%llu dropped=%llu cam silent=%lld/%lld ms blob overflow=%llu/%llu "
-      "clock steps=%llu/%llu outputs failed/dropped=%llu/%llu",
-      elapsed_s, h.fps, interval_s, static_cast<unsigned long long>(e2e.count), e2e.p50_us,
-      e2e.p99_us, e2e.p999_us, e2e.max_us, static_cast<unsigned long long>(h.frames_published),
-      static_cast<unsigned long long>(h.frames_dropped),
-      static_cast<long long>(h.camera_silent_ms[0]), static_cast<long long>(h.camera_silent_ms[1]),
-      static_cast<unsigned long long>(h.detect_overflow_frames[0]),
-      static_cast<unsigned long long>(h.detect_overflow_frames[1]),
-      static_cast<unsigned long long>(h.timestamp_steps[0]),
-      static_cast<unsigned long long>(h.timestamp_steps[1]),
-      static_cast<unsigned long long>(h.output_failures),
-      static_cast<unsigned long long>(h.output_dropped));
+  // Per camera values joined by '/' (one entry per camera of the rig).
+  auto per_camera = [&](auto value) {
+    std::string v;
+    for (int c = 0; c < h.camera_count; ++c) {
+      if (c > 0) v += '/';
+      v += std::to_string(value(static_cast<std::size_t>(c)));
+    }
+    return v;
+  };
+  const std::string silent = per_camera([&](std::size_t c) { return h.camera_silent_ms[c]; });
+  const std::string overflow =
+      per_camera([&](std::size_t c) { return h.detect_overflow_frames[c]; });
+  const std::string steps = per_camera([&](std::size_t c) { return h.timestamp_steps[c]; });
+  char line[480];
+  std::snprintf(line, sizeof line,
+                "t=%.1fs fps=%.1f e2e(last %.1fs, %llu) p50=%.0f p99=%.0f p99.9=%.0f max=%.0f us "
+                "published=%llu dropped=%llu cam silent=%s ms blob overflow=%s "
+                "clock steps=%s outputs failed/dropped=%llu/%llu",
+                elapsed_s, h.fps, interval_s, static_cast<unsigned long long>(e2e.count),
+                e2e.p50_us, e2e.p99_us, e2e.p999_us, e2e.max_us,
+                static_cast<unsigned long long>(h.frames_published),
+                static_cast<unsigned long long>(h.frames_dropped), silent.c_str(), overflow.c_str(),
+                steps.c_str(), static_cast<unsigned long long>(h.output_failures),
+                static_cast<unsigned long long>(h.output_dropped));
   return line;
 }
 

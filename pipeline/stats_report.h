@@ -16,7 +16,8 @@ namespace mocap::pipeline {
 
 std::string format_pipeline_stats(const PipelineStats& stats);
 // One line: "t=12.0s fps=100.0 e2e(last 5.0s) p50=.. p99=.. p99.9=.. max=..us
-// published=.. dropped=.. cam silent=../..ms blob overflow=../.. clock steps=../..".
+// published=.. dropped=.. cam silent=../..ms blob overflow=../.. clock steps=../..", with
+// one '/'-separated value per camera of the rig.
 std::string format_progress_line(double elapsed_s, double interval_s,
                                  const LatencyStats& interval_e2e, const PipelineHealth& health);
 std::string pipeline_stats_json(const PipelineStats& stats);

@@ -4,14 +4,18 @@
 // counters, in microseconds. Two pacings:
 //   Periodic/<rate>: the deployment case, software trigger at <rate> Hz;
 //   Lockstep:        one frame in flight at a time (the latency of an idle pipeline;
-//                    its fps is the throughput bound of one-frame-at-a-time operation).
+//                    its fps is the throughput bound of one-frame-at-a-time operation);
+//   Cameras/<n>:     periodic at 100 Hz with n = 2, 4, 8 simulated cameras (the built-in
+//                    pair / arc, 1032x776; issue 16's scaling, baseline: 2 cameras).
 // The stage table is applied (pinning, SCHED_FIFO) when permitted. The sink is a no-op
 // (the UDP cost is measured by the publisher's own benchmark). Baseline: the paper's
 // 20-30 ms end-to-end latency, reported as paper_ratio = 25 ms / p50.
 #include <benchmark/benchmark.h>
 
 #include <chrono>
+#include <map>
 #include <thread>
+#include <vector>
 
 #include "hal/sim_camera.h"
 #include "pipeline/pipeline.h"
@@ -26,32 +30,39 @@ class NullSink final : public publish::OutputSink {
   bool publish(const publish::FrameResult&) noexcept override { return true; }
 };
 
-std::shared_ptr<const hal::SimFrameLoop> loop() {
-  static std::shared_ptr<const hal::SimFrameLoop> l = [] {
+// The pre-rendered loop of `cameras` simulated cameras (rendered once per count).
+std::shared_ptr<const hal::SimFrameLoop> loop(int cameras = 2) {
+  static std::map<int, std::shared_ptr<const hal::SimFrameLoop>> loops;
+  auto& l = loops[cameras];
+  if (!l) {
     sim::SimOptions o;
-    o.frames = 100;
+    o.frames = cameras == 2 ? 100 : 40;
+    o.cameras = cameras;
     auto r = hal::SimFrameLoop::render(o);
-    return r.ok() ? *r : nullptr;
-  }();
+    if (r.ok()) l = *r;
+  }
   return l;
 }
 
-void run(benchmark::State& state, TriggerPacing pacing, double rate_hz, std::uint64_t frames) {
-  if (!loop()) {
+void run(benchmark::State& state, TriggerPacing pacing, double rate_hz, std::uint64_t frames,
+         int cameras = 2) {
+  if (!loop(cameras)) {
     state.SkipWithError("sim loop failed");
     return;
   }
   PipelineStats st;
   for (auto _ : state) {
-    auto trigger = std::make_shared<hal::SimTrigger>(loop());
-    std::unique_ptr<hal::SimCamera> cams[2];
-    for (int c = 0; c < 2; ++c) {
-      cams[c] = std::move(hal::SimCamera::open(trigger, c)).value();
-      hal::CameraConfig cfg = cams[c]->native_config();
+    auto trigger = std::make_shared<hal::SimTrigger>(loop(cameras));
+    std::vector<std::unique_ptr<hal::SimCamera>> cams;
+    std::vector<hal::Camera*> cam_ptrs;
+    for (int c = 0; c < cameras; ++c) {
+      cams.push_back(std::move(hal::SimCamera::open(trigger, c)).value());
+      hal::CameraConfig cfg = cams.back()->native_config();
       cfg.buffer_count = 6;
-      (void)cams[c]->configure(cfg);
+      (void)cams.back()->configure(cfg);
+      cam_ptrs.push_back(cams.back().get());
     }
-    const sim::SimScene& sc = loop()->scene();
+    const sim::SimScene& sc = loop(cameras)->scene();
     auto proc = FrameProcessor::create(sc.rig, sc.targets, &sc.joints_true, TrackerConfig{});
     NullSink sink;
     PipelineOptions opt;
@@ -59,8 +70,7 @@ void run(benchmark::State& state, TriggerPacing pacing, double rate_hz, std::uin
     opt.trigger_rate_hz = rate_hz;
     opt.max_frames = frames;
     opt.lock_memory = false;
-    auto p =
-        Pipeline::create(std::move(proc).value(), {cams[0].get(), cams[1].get()}, {&sink}, opt);
+    auto p = Pipeline::create(std::move(proc).value(), cam_ptrs, {&sink}, opt);
     if (!p || !(*p)->start()) {
       state.SkipWithError("pipeline start failed");
       return;
@@ -80,6 +90,8 @@ void run(benchmark::State& state, TriggerPacing pacing, double rate_hz, std::uin
       state.counters[name + "_p99_us"] = l.p99_us;
     }
   }
+  for (const auto& [name, v] : st.counters)
+    if (name == "frames_dropped") state.counters["dropped"] = static_cast<double>(v);
   state.counters["published"] = static_cast<double>(st.published);
   state.counters["fps"] = st.fps;
 }
@@ -98,6 +110,17 @@ void BM_PipelineLockstep(benchmark::State& state) {
   run(state, TriggerPacing::kLockstep, 10000.0, 1000);
 }
 BENCHMARK(BM_PipelineLockstep)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_PipelineCameras(benchmark::State& state) {
+  run(state, TriggerPacing::kPeriodic, 100.0, 1000, static_cast<int>(state.range(0)));
+}
+BENCHMARK(BM_PipelineCameras)
+    ->Arg(2)
+    ->Arg(4)
+    ->Arg(8)
+    ->Iterations(1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 }  // namespace
 }  // namespace mocap::pipeline

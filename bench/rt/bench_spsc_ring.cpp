@@ -12,8 +12,8 @@
 #include <cstdint>
 #include <thread>
 
-#include "hal/rt/slot_pool.h"
-#include "hal/rt/spsc_ring.h"
+#include "rt/slot_pool.h"
+#include "rt/spsc_ring.h"
 
 #if __has_include(<boost/lockfree/spsc_queue.hpp>)
 #include <boost/lockfree/spsc_queue.hpp>

@@ -1,4 +1,4 @@
-// Design: the live view's aiming overlay: per stereo camera, a small grey-level image of
+// Design: the live view's aiming overlay: per rig camera, a small grey-level image of
 // where that camera sees blobs and what each became in the frame, drawn from the blob
 // lists of the frame result (no camera image crosses the output seam). Sent on
 // /<camera>/blobs as foxglove.RawImage ("mono8") at a low rate (kBlobOverlayPeriodNs),

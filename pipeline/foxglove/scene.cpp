@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/camera_set.h"
+
 namespace mocap::foxglove {
 
 Rgba body_colour(int index, int count) noexcept {
@@ -55,8 +57,9 @@ Expected<FoxgloveScene> make_scene(const TargetSet& targets, const JointModel* m
     scene.bodies.push_back(SceneBody{name, body_colour(i, n)});
   }
   if (rig != nullptr) {
-    const std::size_t stereo = std::min<std::size_t>(rig->cameras.size(), 2);
-    for (std::size_t c = 0; c < stereo; ++c) {
+    const std::size_t shown =  // every camera of the rig (2..kMaxCameras)
+        std::min<std::size_t>(rig->cameras.size(), static_cast<std::size_t>(kMaxCameras));
+    for (std::size_t c = 0; c < shown; ++c) {
       const CameraModel& cam = rig->cameras[c];
       const bool topic_ok = !cam.name.empty() && cam.name.size() <= 64 &&
                             cam.name.find_first_not_of(

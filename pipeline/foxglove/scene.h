@@ -1,7 +1,7 @@
 // Design: the immutable model of the Foxglove live view, built once at setup from the
 // targets, the joint model and the rig (OutputContext): body names and colours, the
 // world frame id, each calibrated joint's centre and hinge axis in its parent body's
-// frame, and the stereo cameras' names and image sizes (the blob overlays). The
+// frame, and the rig cameras' names and image sizes (the blob overlays). The
 // encoders (encode.h) read it, never change it. Units: the model keeps the project's
 // millimetres; the encoders convert to Foxglove's metres.
 #pragma once
@@ -48,7 +48,7 @@ struct FoxgloveScene {
   double marker_diameter_mm = 12.0;
   std::vector<SceneBody> bodies;
   std::vector<SceneJoint> joints;    // empty without a joint model
-  std::vector<SceneCamera> cameras;  // the stereo cameras; empty without a rig
+  std::vector<SceneCamera> cameras;  // every rig camera (2..8); empty without a rig
 };
 
 // The colour of body i of n: evenly spaced, saturated hues (deterministic).
@@ -56,7 +56,7 @@ Rgba body_colour(int index, int count) noexcept;
 
 // Fails with one line when a body name is empty or equals the world frame, the model
 // names a body index outside the targets, or a camera name is not a topic segment.
-// `rig` may be null (no blob overlays); its first two cameras are the stereo pair.
+// `rig` may be null (no blob overlays); each of its cameras gets a blob channel.
 Expected<FoxgloveScene> make_scene(const TargetSet& targets, const JointModel* model,
                                    const Rig* rig = nullptr,
                                    const std::string& world_frame = "mocap");

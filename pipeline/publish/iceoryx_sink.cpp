@@ -6,9 +6,9 @@
 #include <memory>
 #include <string>
 
-#include "hal/rt/counter.h"
 #include "pipeline/publish/iceoryx_publisher.h"
 #include "pipeline/publish/output_registry.h"
+#include "rt/counter.h"
 
 namespace mocap::publish {
 namespace {

@@ -28,10 +28,10 @@
 #include <thread>
 
 #include "core/expected.h"
-#include "hal/rt/counter.h"
-#include "hal/rt/drop_oldest_queue.h"
 #include "pipeline/doorbell.h"
 #include "pipeline/publish/output_sink.h"
+#include "rt/counter.h"
+#include "rt/drop_oldest_queue.h"
 
 namespace mocap::publish {
 

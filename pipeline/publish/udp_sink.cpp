@@ -7,9 +7,9 @@
 #include <memory>
 #include <string>
 
-#include "hal/rt/counter.h"
 #include "pipeline/publish/output_registry.h"
 #include "pipeline/publish/udp_publisher.h"
+#include "rt/counter.h"
 
 namespace mocap::publish {
 namespace {

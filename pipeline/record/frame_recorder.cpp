@@ -14,6 +14,13 @@ Expected<std::unique_ptr<FrameRecorder>> FrameRecorder::create(const RecorderOpt
         "mocap record", "--buffer-frames",
         "must be a power of two in 2..4096, got " + std::to_string(o.slots_per_camera));
   }
+  const int n = static_cast<int>(o.cameras.size());
+  if (n < kMinCameras || n > kMaxCameras || o.camera_names.size() != o.cameras.size()) {
+    return make_error("mocap record", "cameras",
+                      std::to_string(n) + " cameras (" + std::to_string(o.camera_names.size()) +
+                          " names), expected " + std::to_string(kMinCameras) + ".." +
+                          std::to_string(kMaxCameras));
+  }
   std::size_t max_bytes = 0;
   for (const CameraGeometry& g : o.cameras) {
     if (g.width <= 0 || g.height <= 0)
@@ -22,17 +29,17 @@ Expected<std::unique_ptr<FrameRecorder>> FrameRecorder::create(const RecorderOpt
         std::max(max_bytes, static_cast<std::size_t>(g.width) * static_cast<std::size_t>(g.height) *
                                 static_cast<std::size_t>(bytes_per_pixel(g.format)));
   }
-  auto files =
-      RecordingFiles::open(o.dir, {o.camera_names[0], o.camera_names[1]}, max_bytes, o.byte_budget);
+  auto files = RecordingFiles::open(o.dir, o.camera_names, max_bytes, o.byte_budget);
   if (!files) return files.error();
   std::unique_ptr<FrameRecorder> r(new FrameRecorder(o, std::move(files).value()));
   hal::PairerConfig pc;
   pc.tolerance = o.pair_by == pipeline::PairBy::kSequence ? 0 : o.pair_tolerance_ns;
   pc.max_pending = o.slots_per_camera;
+  pc.cameras = n;
   auto pairer = hal::FramePairer::create(pc);
   if (!pairer) return pairer.error();
   r->pairer_.emplace(std::move(pairer).value());
-  for (std::size_t c = 0; c < 2; ++c) {
+  for (std::size_t c = 0; c < static_cast<std::size_t>(n); ++c) {
     const CameraGeometry& g = o.cameras[c];
     const std::size_t bytes = static_cast<std::size_t>(g.width) *
                               static_cast<std::size_t>(g.height) *
@@ -66,7 +73,8 @@ void FrameRecorder::start() {
 }
 
 void FrameRecorder::on_frame(int camera, const hal::Frame& frame) noexcept {
-  const auto c = static_cast<std::size_t>(camera & 1);
+  if (camera < 0 || camera >= camera_count()) return;  // not a camera of this recording
+  const auto c = static_cast<std::size_t>(camera);
   if (!have_base_) {
     have_base_ = true;
     base_sequence_ = frame.sequence;
@@ -130,7 +138,8 @@ bool FrameRecorder::drain(bool flush) {
     u.slot[camera] = static_cast<std::int32_t>(e.handle);
     units_.push_back(u);
   };
-  for (int c = 0; c < 2; ++c) {
+  const int n = camera_count();
+  for (int c = 0; c < n; ++c) {
     std::uint32_t index = 0;
     while (filled_[static_cast<std::size_t>(c)]->try_pop(index)) {
       got = true;
@@ -141,8 +150,7 @@ bool FrameRecorder::drain(bool flush) {
       hal::FramePair pair;
       if (pairer_->push(c, hal::PairEntry{key, index}, pair, on_drop)) {
         Unit u;
-        u.slot[0] = static_cast<std::int32_t>(pair.cam[0].handle);
-        u.slot[1] = static_cast<std::int32_t>(pair.cam[1].handle);
+        for (int k = 0; k < n; ++k) u.slot[k] = static_cast<std::int32_t>(pair.cam[k].handle);
         u.frame = slots_[0][pair.cam[0].handle].frame;
         units_.push_back(u);
       }
@@ -159,16 +167,18 @@ void FrameRecorder::write_unit(const Unit& u) {
     // same as the tap's numbering unless every image of the first frames was dropped).
     if (first_frame_ < 0) first_frame_ = u.frame;
     const std::int64_t number = u.frame - first_frame_;
-    int written[2] = {-1, -1};
+    const int n = camera_count();
+    int written[kMaxCameras] = {-1, -1, -1, -1, -1, -1, -1, -1};
     Expected<void> r;
-    for (int c = 0; c < 2 && r; ++c) {
+    for (int c = 0; c < n && r; ++c) {
       if (u.slot[c] < 0) continue;
       const Slot& s = slots_[static_cast<std::size_t>(c)][static_cast<std::size_t>(u.slot[c])];
       if (s.missing) continue;
       r = files_.write_image(c, number, s.view);
       if (r) written[c] = c;
     }
-    const int ts_cam = u.slot[0] >= 0 ? 0 : 1;
+    int ts_cam = 0;  // the first camera with an image slot gives the timestamp
+    while (ts_cam + 1 < n && u.slot[ts_cam] < 0) ++ts_cam;
     const Slot& ts =
         slots_[static_cast<std::size_t>(ts_cam)][static_cast<std::size_t>(u.slot[ts_cam])];
     if (r) r = files_.append_row(number, ts.timestamp_ns);
@@ -188,8 +198,33 @@ void FrameRecorder::write_unit(const Unit& u) {
   } else {
     not_written_.add();
   }
-  free_slot(0, u.slot[0]);
-  free_slot(1, u.slot[1]);
+  for (int c = 0; c < camera_count(); ++c) free_slot(c, u.slot[c]);
+}
+
+void FrameRecorder::write_units() {
+  std::sort(units_.begin(), units_.end(),
+            [](const Unit& a, const Unit& b) { return a.frame < b.frame; });
+  // The cameras of one frame dropped by the matcher one by one (a camera missed the
+  // frame) arrive as units of one camera each: merged into one unit per frame.
+  std::size_t out = 0;
+  for (std::size_t i = 0; i < units_.size(); ++i) {
+    if (out > 0 && units_[out - 1].frame == units_[i].frame) {
+      Unit& m = units_[out - 1];
+      for (int c = 0; c < kMaxCameras; ++c) {
+        if (m.slot[c] < 0) {
+          m.slot[c] = units_[i].slot[c];
+        } else if (units_[i].slot[c] >= 0) {  // the same camera twice: cannot happen
+          free_slot(c, units_[i].slot[c]);
+          not_written_.add();
+        }
+      }
+    } else {
+      units_[out++] = units_[i];
+    }
+  }
+  units_.resize(out);
+  for (const Unit& u : units_) write_unit(u);
+  units_.clear();
 }
 
 void FrameRecorder::writer_loop() {
@@ -198,10 +233,7 @@ void FrameRecorder::writer_loop() {
     // drain below sees every frame the tap pushed.
     const bool stopping = stop_.load(std::memory_order_acquire);
     const bool got = drain(stopping);
-    std::sort(units_.begin(), units_.end(),
-              [](const Unit& a, const Unit& b) { return a.frame < b.frame; });
-    for (const Unit& u : units_) write_unit(u);
-    units_.clear();
+    write_units();
     if (stopping) break;
     if (!got) std::this_thread::sleep_for(std::chrono::milliseconds(2));
   }
@@ -213,8 +245,7 @@ Expected<void> FrameRecorder::finish() {
     writer_.join();
   } else {
     drain(true);
-    for (const Unit& u : units_) write_unit(u);
-    units_.clear();
+    write_units();
   }
   auto synced = files_.finish();
   if (error_) return *error_;
@@ -226,7 +257,8 @@ RecorderCounts FrameRecorder::counts() const noexcept {
   k.frames_written = frames_written_.get();
   k.images_written = images_written_.get();
   k.bytes_written = bytes_written_.get();
-  k.dropped = {dropped_[0].get(), dropped_[1].get()};
+  for (int c = 0; c < camera_count(); ++c)
+    k.dropped.push_back(dropped_[static_cast<std::size_t>(c)].get());
   k.not_written = not_written_.get();
   return k;
 }

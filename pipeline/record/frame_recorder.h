@@ -1,7 +1,7 @@
 // Design: `mocap record`'s tap on the live pipeline (pipeline::FrameTap) and its writer.
 //
-//   capture thread --on_frame--> [slot pool per camera: images copied into preallocated
-//   (hot path)                    slots; indices through two SPSC rings: filled / free]
+//   capture thread --on_frame--> [slot pool per camera (2..kMaxCameras): images copied into
+//   (hot path)                    preallocated slots; indices through two SPSC rings]
 //                                        |
 //                     writer thread <----+  pairs the frames with hal::FramePairer (the
 //                     (not real-time)       pipeline's pairing: by trigger sequence or by
@@ -15,10 +15,11 @@
 // pipeline, so that a replay is recorded image for image.
 // Frame numbers: the frame's sequence number minus that of the first frame written (so a
 // replay keeps its source's numbers; a trigger the pipeline skipped is a gap). A frame
-// is one row of frames.csv with the timestamp of camera 0's image (camera 1's when camera
-// 0 has none); a camera without an image for it (dropped, missing in a replay) has no
-// file. After the first write error the writer writes nothing more (the error is kept and
-// failed() turns true); what was written stays a valid recording (RecordingFiles).
+// is one row of frames.csv with the timestamp of the first camera's image that it has; a
+// camera without an image for it (dropped, missing in a replay) has no file (the
+// matcher's partial frames are merged into one unit per frame before writing). After the first
+// write error the writer writes nothing more (the error is kept and failed() turns true); what was
+// written stays a valid recording (RecordingFiles).
 #pragma once
 
 #include <array>
@@ -32,10 +33,10 @@
 
 #include "core/expected.h"
 #include "hal/frame_pairer.h"
-#include "hal/rt/counter.h"
-#include "hal/rt/spsc_ring.h"
 #include "pipeline/pipeline.h"
 #include "pipeline/record/recording_files.h"
+#include "rt/counter.h"
+#include "rt/spsc_ring.h"
 
 namespace mocap::record {
 
@@ -45,9 +46,9 @@ struct CameraGeometry {
 };
 
 struct RecorderOptions {
-  std::string dir;  // exists, holds no frames.csv yet
-  std::array<std::string, 2> camera_names;
-  std::array<CameraGeometry, 2> cameras;  // the configured image sizes (slot sizes)
+  std::string dir;                        // exists, holds no frames.csv yet
+  std::vector<std::string> camera_names;  // one per camera of the rig (2..kMaxCameras)
+  std::vector<CameraGeometry> cameras;    // the configured image sizes (slot sizes), same order
   std::uint32_t slots_per_camera = 64;    // power of two >= 2: the write-behind buffer
   std::uint64_t max_frames = 0;           // frames numbered >= this are ignored (0: all)
   int wait_for_slot_ms = 0;               // > 0 only in lockstep pacing
@@ -60,8 +61,8 @@ struct RecorderCounts {
   std::uint64_t frames_written = 0;  // rows of frames.csv
   std::uint64_t images_written = 0;  // PGM files
   std::uint64_t bytes_written = 0;
-  std::array<std::uint64_t, 2> dropped{};  // images dropped at the tap (no free slot)
-  std::uint64_t not_written = 0;           // frames queued when writing failed or out of order
+  std::vector<std::uint64_t> dropped;  // per camera: images dropped at the tap (no free slot)
+  std::uint64_t not_written = 0;       // frames queued when writing failed or out of order
 };
 
 class FrameRecorder final : public pipeline::FrameTap {
@@ -95,7 +96,7 @@ class FrameRecorder final : public pipeline::FrameTap {
   };
   struct Unit {  // one frame to write: slot index per camera, -1 if none
     std::int64_t frame = 0;
-    std::int32_t slot[2] = {-1, -1};
+    std::int32_t slot[kMaxCameras] = {-1, -1, -1, -1, -1, -1, -1, -1};
   };
 
   explicit FrameRecorder(const RecorderOptions& options, RecordingFiles files);
@@ -103,12 +104,16 @@ class FrameRecorder final : public pipeline::FrameTap {
   // Pops the filled rings into the pairer; appends the completed frames to units_.
   bool drain(bool flush);
   void write_unit(const Unit& u);
+  // Sorts units_ by frame, merges the units of one frame, writes them, clears units_.
+  void write_units();
   void free_slot(int camera, std::int32_t slot) noexcept;
 
   RecorderOptions options_;
   RecordingFiles files_;
-  std::array<std::vector<Slot>, 2> slots_;
-  std::array<std::unique_ptr<rt::SpscRing<std::uint32_t>>, 2> filled_, free_;
+  int camera_count() const noexcept { return static_cast<int>(options_.cameras.size()); }
+
+  std::array<std::vector<Slot>, kMaxCameras> slots_;
+  std::array<std::unique_ptr<rt::SpscRing<std::uint32_t>>, kMaxCameras> filled_, free_;
   std::optional<hal::FramePairer> pairer_;  // writer thread
   std::vector<Unit> units_;                 // writer thread, reserved
   std::int64_t last_frame_ = -1;            // writer thread: tap numbering
@@ -119,7 +124,7 @@ class FrameRecorder final : public pipeline::FrameTap {
   bool have_base_ = false;
   std::uint64_t base_sequence_ = 0;
 
-  rt::Counter dropped_[2], frames_written_, images_written_, bytes_written_, not_written_;
+  rt::Counter dropped_[kMaxCameras], frames_written_, images_written_, bytes_written_, not_written_;
   std::atomic<std::uint64_t> seen_{0};
   std::atomic<bool> failed_{false};
   std::atomic<bool> stop_{false};

@@ -16,8 +16,8 @@ namespace mocap::service {
 
 using config::CameraBackend;
 
-static_assert(config::kStageCount == pipeline::kStageCount,
-              "config::kStageNames lists the stages of pipeline/stage_table.h");
+static_assert(config::kStageCount == pipeline::kStageKinds,
+              "config::kStageNames lists the stage kinds of pipeline/stage_table.h");
 
 Expected<config::RunConfig> resolve_run_config(const std::string& path, const CliOverrides& cli,
                                                bool targets_required) {
@@ -90,7 +90,14 @@ pipeline::PipelineOptions pipeline_options(const config::RunConfig& cfg) {
   o.dequeue_timeout_ms = cfg.pipeline.dequeue_timeout_ms;
   for (std::size_t i = 0; i < config::kStageCount; ++i) {
     const config::StageSettings& s = cfg.pipeline.stages[i];
-    pipeline::StageSpec& d = o.stages[i];
+    pipeline::StageSpec& d = o.stages.rows[i];
+    if (s.cpu) d.cpu = *s.cpu;
+    if (s.priority) d.fifo_priority = *s.priority;
+    if (s.ring_depth) d.ring_depth = *s.ring_depth;
+  }
+  for (std::size_t c = 0; c < cfg.pipeline.detect_camera.size(); ++c) {  // detect<k>
+    const config::StageSettings& s = cfg.pipeline.detect_camera[c];
+    pipeline::DetectOverride& d = o.stages.detect[c];
     if (s.cpu) d.cpu = *s.cpu;
     if (s.priority) d.fifo_priority = *s.priority;
     if (s.ring_depth) d.ring_depth = *s.ring_depth;
@@ -141,12 +148,13 @@ Expected<std::unique_ptr<LiveSetup>> LiveSetup::create(const config::RunConfig& 
   const CameraBackend backend = cfg.cameras[0].backend;
   Expected<config::TrackingAssets> assets = Error{};
   std::shared_ptr<hal::LibcameraSession> session;
-  std::array<std::unique_ptr<hal::Camera>, 2> cams;
-  std::array<hal::CameraConfig, 2> native{};
+  const std::size_t n = cfg.cameras.size();
+  std::vector<std::unique_ptr<hal::Camera>> cams(n);
+  std::vector<hal::CameraConfig> native(n);
   if (backend == CameraBackend::kSim) {
     say(log,
         "rendering the simulated camera loop (" + std::to_string(cfg.sim.loop_frames) +
-            " frames x 2 cameras)...",
+            " frames x " + std::to_string(n) + " cameras)...",
         command);
     auto loop = hal::SimFrameLoop::render(config::sim_options(cfg));
     if (!loop) return loop.error();
@@ -157,7 +165,7 @@ Expected<std::unique_ptr<LiveSetup>> LiveSetup::create(const config::RunConfig& 
     s->trigger_ = std::make_shared<hal::SimTrigger>(s->loop_);
     const sim::SimScene& scene = s->loop_->scene();
     assets = config::load_tracking_assets(cfg, &scene.rig, &scene.targets, &scene.joints_true);
-    for (int c = 0; c < 2; ++c) {
+    for (int c = 0; c < static_cast<int>(n); ++c) {
       auto cam = hal::SimCamera::open(s->trigger_, c);
       if (!cam) return cam.error();
       native[static_cast<std::size_t>(c)] = (*cam)->native_config();
@@ -169,7 +177,12 @@ Expected<std::unique_ptr<LiveSetup>> LiveSetup::create(const config::RunConfig& 
     s->recording_ = std::make_shared<const Recording>(std::move(rec).value());
     assets = config::load_tracking_assets(cfg, &s->recording_->rig(), nullptr, nullptr,
                                           targets_required);
-    for (int c = 0; c < 2; ++c) {
+    if (assets && s->recording_->rig().cameras.size() != n) {
+      return make_error(cfg.path.empty() ? std::string(command) : cfg.path, "cameras",
+                        std::to_string(n) + " cameras, the recording has " +
+                            std::to_string(s->recording_->rig().cameras.size()));
+    }
+    for (int c = 0; c < static_cast<int>(n); ++c) {
       auto cam = hal::ReplayCamera::open(s->recording_, c, hal::ReplayPacing::kRecordedTiming);
       if (!cam) return cam.error();
       native[static_cast<std::size_t>(c)] = (*cam)->native_config();
@@ -178,7 +191,7 @@ Expected<std::unique_ptr<LiveSetup>> LiveSetup::create(const config::RunConfig& 
   } else {
     assets = config::load_tracking_assets(cfg, nullptr, nullptr, nullptr, targets_required);
     if (!assets) return assets.error();
-    for (std::size_t c = 0; c < 2; ++c) {
+    for (std::size_t c = 0; c < n; ++c) {
       const std::string& device = cfg.cameras[c].device;
       if (backend == CameraBackend::kV4l2) {
         auto cam = hal::V4l2Camera::open(device);
@@ -204,9 +217,16 @@ Expected<std::unique_ptr<LiveSetup>> LiveSetup::create(const config::RunConfig& 
   }
   if (!assets) return assets.error();
 
-  for (std::size_t c = 0; c < 2; ++c) {
-    const std::uint32_t depth =
-        s->options_.stages[pipeline::index(pipeline::StageId::kDetect0) + c].ring_depth;
+  if (assets->rig.cameras.size() != n) {
+    return make_error(
+        cfg.path.empty() ? std::string(command) : cfg.path, "cameras",
+        std::to_string(n) + " cameras, the rig has " + std::to_string(assets->rig.cameras.size()));
+  }
+  for (std::size_t c = 0; c < n; ++c) {
+    const std::uint32_t depth =  // the stage table's detect rule (CPU count irrelevant here)
+        pipeline::resolve_stage(s->options_.stages, pipeline::StageId::detect(static_cast<int>(c)),
+                                1)
+            .ring_depth;
     const hal::CameraConfig want =
         camera_config(cfg.cameras[c], native[c], assets->rig.cameras[c], depth);
     if (auto r = cams[c]->configure(want); !r) return r.error();

@@ -69,7 +69,12 @@ class LiveSetup {
                                                      const char* command = "mocap run",
                                                      bool targets_required = true);
 
-  std::array<hal::Camera*, 2> cameras() const noexcept { return {cams_[0].get(), cams_[1].get()}; }
+  // The rig's cameras (2..kMaxCameras) in rig order.
+  std::vector<hal::Camera*> cameras() const {
+    std::vector<hal::Camera*> v;
+    for (const auto& c : cams_) v.push_back(c.get());
+    return v;
+  }
   // The tracker, to be moved into the pipeline (once).
   FrameProcessor take_processor() { return std::move(*processor_); }
   const pipeline::PipelineOptions& options() const noexcept { return options_; }
@@ -84,7 +89,7 @@ class LiveSetup {
   std::shared_ptr<const hal::SimFrameLoop> loop_;
   std::shared_ptr<hal::SimTrigger> trigger_;
   std::shared_ptr<const Recording> recording_;
-  std::array<std::unique_ptr<hal::Camera>, 2> cams_;
+  std::vector<std::unique_ptr<hal::Camera>> cams_;
   std::optional<FrameProcessor> processor_;
   config::TrackingAssets assets_;
   pipeline::PipelineOptions options_;

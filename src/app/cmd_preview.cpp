@@ -110,8 +110,8 @@ int preview(const PreviewArgs& a) {
   std::signal(SIGTERM, on_preview_signal);
   auto live = service::LiveSetup::create(*cfg, stderr, "mocap preview", false);
   if (!live) return fail(live.error().message);
-  const std::array<hal::CameraConfig, 2> cams = {(*live)->cameras()[0]->config(),
-                                                 (*live)->cameras()[1]->config()};
+  std::vector<hal::CameraConfig> cams;
+  for (const hal::Camera* cam : (*live)->cameras()) cams.push_back(cam->config());
   record::SnapshotTap tap(cams, static_cast<std::uint64_t>(a.frames));
   pipeline::PipelineOptions opt = (*live)->options();
   opt.tap = &tap;
@@ -126,7 +126,7 @@ int preview(const PreviewArgs& a) {
   (*pipe)->stop();
   std::string json = "{\"cameras\": [";
   const detect::DetectorConfig& dc = cfg->tracker.detect;
-  for (int c = 0; c < 2; ++c) {
+  for (int c = 0; c < static_cast<int>(cams.size()); ++c) {
     const std::string& name = (*live)->assets().rig.cameras[static_cast<std::size_t>(c)].name;
     if (tap.count(c) == 0)
       return fail(name + ": no image within 10 s (camera " + std::to_string(c) + ")");

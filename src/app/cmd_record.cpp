@@ -65,6 +65,12 @@ Expected<void> check_args(const RecordArgs& a) {
   return {};
 }
 
+std::uint64_t total(const std::vector<std::uint64_t>& v) {
+  std::uint64_t t = 0;
+  for (std::uint64_t x : v) t += x;
+  return t;
+}
+
 // Data rate of the cameras as configured, MB/s (for the drop warning).
 double camera_rate_mb_s(const record::RecorderOptions& o, double rate_hz) {
   double bytes = 0.0;
@@ -96,10 +102,11 @@ int record(const RecordArgs& a) {
   const bool lockstep = opt.pacing == pipeline::TriggerPacing::kLockstep;
   record::RecorderOptions ro;
   ro.dir = a.out;
-  for (std::size_t c = 0; c < 2; ++c) {
-    const hal::CameraConfig& cc = (*live)->cameras()[c]->config();
-    ro.camera_names[c] = (*live)->assets().rig.cameras[c].name;
-    ro.cameras[c] = record::CameraGeometry{cc.width, cc.height, cc.format};
+  const std::vector<hal::Camera*> cams = (*live)->cameras();
+  for (std::size_t c = 0; c < cams.size(); ++c) {  // every camera of the rig: one folder each
+    const hal::CameraConfig& cc = cams[c]->config();
+    ro.camera_names.push_back((*live)->assets().rig.cameras[c].name);
+    ro.cameras.push_back(record::CameraGeometry{cc.width, cc.height, cc.format});
   }
   ro.slots_per_camera = static_cast<std::uint32_t>(a.buffer_frames);
   // A replay ends with its source: the pipeline triggers its frames (lockstep: one frame
@@ -159,7 +166,7 @@ int record(const RecordArgs& a) {
       const record::RecorderCounts k = (*recorder)->counts();
       std::fprintf(stderr, "mocap record: %.1f s, %llu frames, %llu dropped, %.1f MB/s\n",
                    since(t0), static_cast<unsigned long long>(k.frames_written),
-                   static_cast<unsigned long long>(k.dropped[0] + k.dropped[1]),
+                   static_cast<unsigned long long>(total(k.dropped)),
                    static_cast<double>(k.bytes_written - last.bytes_written) / 1e6 / dt);
       last = k;
     }
@@ -175,16 +182,19 @@ int record(const RecordArgs& a) {
               static_cast<unsigned long long>(k.frames_written),
               static_cast<unsigned long long>(k.images_written),
               static_cast<double>(k.bytes_written) / 1e6, elapsed_s, a.out.c_str());
+  std::string per_camera;  // "cam0 N, cam1 N, ..."
+  for (std::size_t c = 0; c < k.dropped.size(); ++c)
+    per_camera +=
+        (c > 0 ? ", cam" : "cam") + std::to_string(c) + " " + std::to_string(k.dropped[c]);
   std::printf(
-      "mocap record: dropped images: cam0 %llu, cam1 %llu (writer behind); "
+      "mocap record: dropped images: %s (writer behind); "
       "frames the cameras dropped: %llu\n",
-      static_cast<unsigned long long>(k.dropped[0]), static_cast<unsigned long long>(k.dropped[1]),
-      static_cast<unsigned long long>(camera_drops));
-  if (k.dropped[0] + k.dropped[1] > 0) {
+      per_camera.c_str(), static_cast<unsigned long long>(camera_drops));
+  if (total(k.dropped) > 0) {
     std::fprintf(stderr,
                  "mocap record: warning: %llu images dropped because the disk wrote %.1f MB/s, "
                  "slower than the cameras' %.1f MB/s (their frames have missing files)\n",
-                 static_cast<unsigned long long>(k.dropped[0] + k.dropped[1]),
+                 static_cast<unsigned long long>(total(k.dropped)),
                  elapsed_s > 0.0 ? static_cast<double>(k.bytes_written) / 1e6 / elapsed_s : 0.0,
                  camera_rate_mb_s(ro, opt.trigger_rate_hz));
   }

@@ -138,7 +138,7 @@ void supervise(const pipeline::Pipeline& pipe, const RunArgs& a, service::Superv
 // One warning line per camera whose images overflowed the detector or whose clock
 // stepped (the counters say how often; docs/pipeline.md).
 void report_camera_faults(const pipeline::PipelineHealth& h) {
-  for (int c = 0; c < 2; ++c) {
+  for (int c = 0; c < h.camera_count; ++c) {
     const auto i = static_cast<std::size_t>(c);
     if (h.detect_overflow_frames[i] > 0)
       std::fprintf(stderr,

@@ -21,8 +21,7 @@ std::string num(double v) {
 
 }  // namespace
 
-Section::Section(const YAML::Node& node, std::string where,
-                 std::initializer_list<std::string_view> keys)
+Section::Section(const YAML::Node& node, std::string where, std::span<const std::string_view> keys)
     : map_(node), where_(std::move(where)) {
   if (!node.IsDefined() || node.IsNull()) {
     map_ = YAML::Node(YAML::NodeType::Map);

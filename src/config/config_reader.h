@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <initializer_list>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -22,7 +23,11 @@ namespace mocap::config_detail {
 class Section {
  public:
   // `node` must be a map (or absent/null: an empty section). Throws on unknown keys.
-  Section(const YAML::Node& node, std::string where, std::initializer_list<std::string_view> keys);
+  Section(const YAML::Node& node, std::string where, std::initializer_list<std::string_view> keys)
+      : Section(node, std::move(where),
+                std::span<const std::string_view>(keys.begin(), keys.size())) {}
+  // The same with keys built at run time (e.g. one per camera).
+  Section(const YAML::Node& node, std::string where, std::span<const std::string_view> keys);
 
   const std::string& where() const noexcept { return where_; }
   bool has(std::string_view key) const;

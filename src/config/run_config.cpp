@@ -12,6 +12,7 @@
 
 #include "config/config_reader.h"
 #include "config/tracking_assets.h"
+#include "formats/rig_yaml.h"
 #include "formats/text_io.h"
 #include "formats/yaml_read.h"
 
@@ -145,26 +146,36 @@ void read_camera(const YAML::Node& node, const std::string& where, const std::st
 
 void read_cameras(const YAML::Node& node, const std::string& dir, RunConfig& cfg) {
   formats_detail::require_list(node, "cameras");
-  if (node.size() != 2) {
-    fail("cameras", "expected 2 cameras (the stereo pair), got " + std::to_string(node.size()) +
-                        line_suffix(node));
+  const std::size_t n = node.size();
+  if (n < static_cast<std::size_t>(kMinCameras) || n > static_cast<std::size_t>(kMaxCameras)) {
+    fail("cameras",
+         std::to_string(n) + (n == 1 ? " camera, " : " cameras, ") +
+             (n < static_cast<std::size_t>(kMinCameras) ? "at least " : "at most ") +
+             std::to_string(n < static_cast<std::size_t>(kMinCameras) ? kMinCameras : kMaxCameras) +
+             line_suffix(node));
   }
-  for (std::size_t c = 0; c < 2; ++c)
+  cfg.cameras.assign(n, CameraSettings{});
+  for (std::size_t c = 0; c < n; ++c)
     read_camera(node[c], index_path("cameras", c), dir, cfg.cameras[c]);
-  const CameraSettings &a = cfg.cameras[0], &b = cfg.cameras[1];
-  if (a.backend != b.backend) {
-    fail("cameras[1].backend", std::string("must match cameras[0].backend (") +
+  const CameraSettings& a = cfg.cameras[0];
+  for (std::size_t c = 1; c < n; ++c) {
+    const CameraSettings& b = cfg.cameras[c];
+    const std::string where = index_path("cameras", c);
+    if (a.backend != b.backend) {
+      fail(where + ".backend", std::string("must match cameras[0].backend (") +
                                    to_string(a.backend) + "), got " + to_string(b.backend) +
-                                   line_suffix(node[1]));
-  }
-  if (a.backend == CameraBackend::kReplay && a.device != b.device) {
-    fail("cameras[1].device", "must name the same recording as cameras[0].device (" + a.device +
-                                  ")" + line_suffix(node[1]));
-  }
-  if (a.backend != CameraBackend::kReplay && a.backend != CameraBackend::kSim &&
-      a.device == b.device) {
-    fail("cameras[1].device",
-         "the same device as cameras[0]: '" + a.device + "'" + line_suffix(node[1]));
+                                   line_suffix(node[c]));
+    }
+    if (a.backend == CameraBackend::kReplay && a.device != b.device) {
+      fail(where + ".device", "must name the same recording as cameras[0].device (" + a.device +
+                                  ")" + line_suffix(node[c]));
+    }
+    for (std::size_t o = 0;
+         o < c && a.backend != CameraBackend::kReplay && a.backend != CameraBackend::kSim; ++o) {
+      if (cfg.cameras[o].device == b.device)
+        fail(where + ".device", "the same device as " + index_path("cameras", o) + ": '" +
+                                    b.device + "'" + line_suffix(node[c]));
+    }
   }
 }
 
@@ -178,14 +189,15 @@ void read_pipeline(const YAML::Node& node, PipelineSettings& p) {
   set(p.realtime, s.flag("realtime"));
   set(p.lock_memory, s.flag("lock_memory"));
   set(p.dequeue_timeout_ms, s.integer("dequeue_timeout_ms", 1, 1000));
-  const Section stages(
-      s.node("stages"), s.path("stages"),
-      {kStageNames[0], kStageNames[1], kStageNames[2], kStageNames[3], kStageNames[4]});
+  // Keys: the stage kinds, then detect0..detect<kMaxCameras-1> (one camera's detect stage).
+  std::vector<std::string> keys(kStageNames.begin(), kStageNames.end());
+  for (int c = 0; c < kMaxCameras; ++c) keys.push_back("detect" + std::to_string(c));
+  const std::vector<std::string_view> key_views(keys.begin(), keys.end());
+  const Section stages(s.node("stages"), s.path("stages"), key_views);
   const long cpus = sysconf(_SC_NPROCESSORS_CONF);
-  for (std::size_t i = 0; i < kStageCount; ++i) {
-    const Section st(stages.node(kStageNames[i]), stages.path(kStageNames[i]),
-                     {"cpu", "priority", "ring_depth"});
-    StageSettings& out = p.stages[i];
+  for (std::size_t i = 0; i < keys.size(); ++i) {
+    const Section st(stages.node(keys[i]), stages.path(keys[i]), {"cpu", "priority", "ring_depth"});
+    StageSettings& out = i < kStageCount ? p.stages[i] : p.detect_camera[i - kStageCount];
     if (const auto v = st.integer("cpu", -1, 1023)) {
       if (cpus > 0 && *v >= cpus)
         st.bad("cpu", "this machine has CPUs 0.." + std::to_string(cpus - 1) + ", got " +
@@ -360,15 +372,43 @@ Expected<RunConfig> parse(const std::string& path, const YAML::Node& root) {
   read_detection(top.node("detection"), cfg.tracker.detect);
   read_stereo(top.node("stereo"), cfg.tracker.stereo);
   read_identification(top.node("identification"), cfg.tracker.identify);
-  const Section sim(top.node("sim"), "sim", {"loop_frames", "scene"});
+  const Section sim(top.node("sim"), "sim", {"loop_frames", "scene", "cameras", "rig"});
   set(cfg.sim.loop_frames, sim.integer("loop_frames", 2, 2000));
   set(cfg.sim.scene,
       sim.choice<mocap::sim::SceneKind>("scene", {{"limbs", mocap::sim::SceneKind::kLimbs},
                                                   {"stalks", mocap::sim::SceneKind::kStalks}}));
-  for (const char* key : {"loop_frames", "scene"}) {
+  for (const char* key : {"loop_frames", "scene", "cameras", "rig"}) {
     if (sim.has(key) && cfg.cameras[0].backend != CameraBackend::kSim)
       sim.bad(key, std::string("only used by the sim backend (cameras use ") +
                        to_string(cfg.cameras[0].backend) + ")");
+  }
+  // The simulated camera count: sim.cameras, sim.rig's cameras or the length of the
+  // cameras list (any of them, agreeing); kept as cfg.cameras.size() (its one home).
+  std::optional<std::int64_t> sim_cameras = sim.integer("cameras", kMinCameras, kMaxCameras);
+  if (const auto v = sim.text("rig")) {
+    cfg.sim.rig_path = resolve(base, *v);
+    const auto rig = load_rig(cfg.sim.rig_path);
+    if (!rig) sim.bad("rig", rig.error().message);
+    const auto n = static_cast<std::int64_t>(rig->cameras.size());
+    if (sim_cameras && *sim_cameras != n)
+      sim.bad("cameras",
+              std::to_string(*sim_cameras) + " cameras, but sim.rig has " + std::to_string(n));
+    sim_cameras = n;
+  }
+  if (sim_cameras) {
+    if (top.has("cameras") && static_cast<std::size_t>(*sim_cameras) != cfg.cameras.size())
+      sim.bad(sim.has("cameras") ? "cameras" : "rig", std::to_string(*sim_cameras) +
+                                                          " cameras, but the cameras list has " +
+                                                          std::to_string(cfg.cameras.size()));
+    if (!top.has("cameras"))
+      cfg.cameras.assign(static_cast<std::size_t>(*sim_cameras), CameraSettings{});
+  }
+  for (std::size_t k = cfg.cameras.size(); k < cfg.pipeline.detect_camera.size(); ++k) {
+    const StageSettings& d = cfg.pipeline.detect_camera[k];
+    if (d.cpu || d.priority || d.ring_depth)
+      fail("pipeline.stages.detect" + std::to_string(k), "no camera " + std::to_string(k) + " (" +
+                                                             std::to_string(cfg.cameras.size()) +
+                                                             " cameras)");
   }
   const Section svc(top.node("service"), "service", {"status_interval_s", "log_interval_s"});
   set(cfg.service.status_interval_s, svc.number("status_interval_s", 0.1, 3600.0));

@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "core/camera_set.h"
 #include "core/expected.h"
 #include "core/image.h"
 #include "sim/scene_layouts.h"
@@ -46,10 +47,12 @@ struct CameraSettings {
   std::optional<int> buffers;           // driver buffers; default: ring depth + 3
 };
 
-// The pipeline's stages, in the order of pipeline/stage_table.h (kDefaultStages).
-inline constexpr std::size_t kStageCount = 5;
-inline constexpr std::array<const char*, kStageCount> kStageNames = {
-    "capture", "detect0", "detect1", "identify", "publish"};
+// The pipeline's stage kinds, in the order of pipeline/stage_table.h (kDefaultStages):
+// `pipeline.stages.<kind>`; `detect` is the rule of every camera's detect stage (its cpu
+// is the first CPU of the rotation), `detect<k>` (k in 0..cameras-1) one camera's.
+inline constexpr std::size_t kStageCount = 4;
+inline constexpr std::array<const char*, kStageCount> kStageNames = {"capture", "detect",
+                                                                     "identify", "publish"};
 
 struct StageSettings {                      // unset: the default table's value
   std::optional<int> cpu;                   // -1: not pinned
@@ -64,6 +67,7 @@ struct PipelineSettings {
   bool lock_memory = true;  // mlockall (falls back when not permitted)
   int dequeue_timeout_ms = 20;
   std::array<StageSettings, kStageCount> stages{};
+  std::array<StageSettings, kMaxCameras> detect_camera{};  // stages.detect<k>
 };
 
 // A further output of the `outputs:` map (ros2, foxglove, ... : any key other than udp
@@ -85,7 +89,15 @@ struct OutputSettings {
 };
 
 struct SimSettings {
-  int loop_frames = 200;                          // frames pre-rendered for the sim backend
+  int loop_frames = 200;  // frames pre-rendered for the sim backend
+  // The key `sim.cameras` (2..8, sim/scene_cameras.h: the stereo pair, or 3..8 on an arc
+  // around the robot) sets RunConfig::cameras to that many sim cameras: the count's one
+  // home is cameras.size().
+  // The key `sim.rig`: render the simulated cameras through this rig.yaml (2..8 cameras,
+  // any size, e.g. 4 x 1280x1024; its camera count is read at load time, the simulator
+  // checks the rest) instead of the built-in ones; the tracker uses it too unless `rig:`
+  // is given.
+  std::string rig_path;                           // absolute; empty: the built-in cameras
   sim::SceneKind scene = sim::SceneKind::kLimbs;  // marker layout of the simulated robot
 };
 
@@ -103,7 +115,9 @@ struct FaultSettings {
 
 struct RunConfig {
   std::string path;  // the file it was loaded from; empty for the built-in defaults
-  std::array<CameraSettings, 2> cameras{};
+  // The rig's cameras in rig order, kMinCameras..kMaxCameras, all of one backend. Without
+  // a `cameras:` list: sim.cameras simulated cameras.
+  std::vector<CameraSettings> cameras = std::vector<CameraSettings>(2);
   std::string rig_path;      // absolute; empty: the backend's (sim scene / recording)
   std::string targets_path;  // absolute; empty: the sim scene's (sim only)
   std::string model_path;    // absolute; empty: sim: the scene's true model; else none
@@ -117,6 +131,7 @@ struct RunConfig {
 
 // The configuration `mocap run` uses without a file: the simulated stereo pair of the
 // built-in scenario, UDP to 127.0.0.1:7755 and iceoryx.
+// (`sim: {cameras: N}` in a file gives N simulated cameras.)
 RunConfig default_run_config();
 
 // Parses, validates every key, resolves paths and loads the referenced rig, targets and

@@ -10,6 +10,8 @@ namespace mocap::config {
 sim::SimOptions sim_options(const RunConfig& cfg) {
   sim::SimOptions so;
   so.frames = cfg.sim.loop_frames;
+  so.cameras = static_cast<int>(cfg.cameras.size());
+  so.rig_path = cfg.sim.rig_path;  // empty: the built-in cameras
   so.scene = cfg.sim.scene;
   so.fps = cfg.pipeline.trigger_rate_hz;
   return so;
@@ -47,12 +49,15 @@ Expected<TrackingAssets> load_tracking_assets(const RunConfig& cfg, const Rig* n
   } else if (native_model != nullptr && cfg.targets_path.empty()) {
     a.model = *native_model;  // the native model belongs to the native targets
   }
-  if (a.rig.cameras.size() < 2) {
-    return make_error(file, "rig",
-                      "the tracker needs two cameras (the stereo pair), the rig has " +
-                          std::to_string(a.rig.cameras.size()));
+  // Every camera of the rig takes part (interfaces.md, "Extensions"): one configured
+  // camera per rig camera, in rig order.
+  if (a.rig.cameras.size() != cfg.cameras.size()) {
+    return make_error(file, "cameras",
+                      std::to_string(cfg.cameras.size()) + " cameras, the rig has " +
+                          std::to_string(a.rig.cameras.size()) +
+                          " (list one camera per rig camera, in rig order)");
   }
-  for (std::size_t c = 0; c < 2; ++c) {
+  for (std::size_t c = 0; c < cfg.cameras.size(); ++c) {
     const CameraSettings& s = cfg.cameras[c];
     const CameraModel& m = a.rig.cameras[c];
     if (s.width != 0 && (s.width != m.width || s.height != m.height)) {

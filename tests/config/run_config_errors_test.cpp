@@ -43,8 +43,21 @@ const ErrorCase kCases[] = {
     {"BadVersion", "version: 2\n", "version: must be in [1, 1], got 2 (line 1)"},
     {"CamerasNotAList", "cameras: {backend: sim}\n",
      "cameras: expected a list, got a map (line 1)"},
-    {"OneCamera", "cameras: [{backend: sim}]\n",
-     "cameras: expected 2 cameras (the stereo pair), got 1 (line 1)"},
+    {"OneCamera", "cameras: [{backend: sim}]\n", "cameras: 1 camera, at least 2 (line 1)"},
+    {"NineCameras",
+     "cameras: [{backend: sim}, {backend: sim}, {backend: sim}, {backend: sim},\n"
+     "  {backend: sim}, {backend: sim}, {backend: sim}, {backend: sim}, {backend: sim}]\n",
+     "cameras: 9 cameras, at most 8 (line 1)"},
+    {"SimCamerasDisagree", "cameras: [{backend: sim}, {backend: sim}]\nsim: {cameras: 3}\n",
+     "sim.cameras: 3 cameras, but the cameras list has 2 (line 2)"},
+    {"SimCamerasRange", "sim: {cameras: 9}\n", "sim.cameras: must be in [2, 8], got 9 (line 1)"},
+    {"DetectStageWithoutCamera", "pipeline: {stages: {detect2: {cpu: 0}}}\n",
+     "pipeline.stages.detect2: no camera 2 (2 cameras)"},
+    {"RigHasOtherCameraCount",
+     "cameras:\n  - {backend: v4l2, device: /dev/video0}\n  - {backend: v4l2, device: "
+     "/dev/video1}\n"
+     "  - {backend: v4l2, device: /dev/video2}\n" ASSETS,
+     "cameras: 3 cameras, the rig has 2 (list one camera per rig camera, in rig order)"},
     {"MissingBackend", "cameras: [{trigger: software}, {backend: sim}]\n",
      "cameras[0].backend: missing key (line 1)"},
     {"UnknownBackend", "cameras: [{backend: usb}, {backend: sim}]\n",
@@ -127,8 +140,8 @@ const ErrorCase kCases[] = {
     {"DequeueTimeout", "pipeline: {dequeue_timeout_ms: 0}\n",
      "pipeline.dequeue_timeout_ms: must be in [1, 1000], got 0 (line 1)"},
     {"UnknownStage", "pipeline: {stages: {triangulate: {cpu: 0}}}\n",
-     "pipeline.stages.triangulate: unknown key (line 1); expected one of: capture, detect0, "
-     "detect1, identify, publish"},
+     "pipeline.stages.triangulate: unknown key (line 1); expected one of: capture, detect, "
+     "identify, publish, detect0, detect1, detect2, detect3, detect4, detect5, detect6, detect7"},
     {"UnknownStageKey", "pipeline: {stages: {detect0: {core: 0}}}\n",
      "pipeline.stages.detect0.core: unknown key (line 1); expected one of: cpu, priority, "
      "ring_depth"},

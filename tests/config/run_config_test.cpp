@@ -39,10 +39,11 @@ TEST(RunConfig, ShippedExampleLoads) {
   EXPECT_EQ(cfg->cameras[0].trigger, TriggerKind::kSoftware);
   EXPECT_EQ(cfg->cameras[1].trigger, TriggerKind::kExternal);
   EXPECT_DOUBLE_EQ(cfg->pipeline.trigger_rate_hz, 100.0);
-  ASSERT_TRUE(cfg->pipeline.stages[2].cpu.has_value());
+  ASSERT_TRUE(cfg->pipeline.stages[2].cpu.has_value());  // identify
   EXPECT_EQ(*cfg->pipeline.stages[2].cpu, 1);
-  EXPECT_EQ(*cfg->pipeline.stages[1].ring_depth, 3u);
+  EXPECT_EQ(*cfg->pipeline.stages[1].ring_depth, 3u);  // the detect rule
   EXPECT_FALSE(cfg->pipeline.stages[0].ring_depth.has_value());
+  EXPECT_FALSE(cfg->pipeline.detect_camera[1].cpu.has_value());
   ASSERT_EQ(cfg->outputs.udp.size(), 1u);
   EXPECT_EQ(cfg->outputs.udp[0], "127.0.0.1:7755");
   EXPECT_DOUBLE_EQ(cfg->tracker.detect.max_elongation, 1.3);
@@ -62,6 +63,7 @@ TEST(RunConfig, MinimalFileKeepsTheDefaults) {
   EXPECT_DOUBLE_EQ(cfg->tracker.identify.t_mm, TrackerConfig{}.identify.t_mm);
   EXPECT_EQ(cfg->faults.stall_after_frames, 0u);
   EXPECT_FALSE(cfg->pipeline.stages[3].priority.has_value());
+  EXPECT_EQ(cfg->cameras.size(), 2u);
 }
 
 TEST(RunConfig, ThresholdsAndOutputsAreRead) {
@@ -87,8 +89,23 @@ TEST(RunConfig, ThresholdsAndOutputsAreRead) {
   EXPECT_FALSE(cfg->tracker.identify.temporal);
   EXPECT_EQ(cfg->pipeline.pacing, Pacing::kLockstep);
   EXPECT_FALSE(cfg->pipeline.realtime);
-  EXPECT_EQ(*cfg->pipeline.stages[4].cpu, -1);
+  EXPECT_EQ(*cfg->pipeline.stages[3].cpu, -1);
   EXPECT_EQ(cfg->faults.stall_after_frames, 50u);
+}
+
+TEST(RunConfig, SimCameraCountAndDetectStages) {
+  TempDir dir("cfg_ncam");
+  write_file(dir.file("m.yaml"),
+             "sim: {cameras: 4, loop_frames: 2}\n"
+             "pipeline: {stages: {detect: {priority: 65}, detect3: {cpu: -1, ring_depth: 5}}}\n");
+  auto cfg = load_run_config(dir.file("m.yaml"));
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  ASSERT_EQ(cfg->cameras.size(), 4u);
+  EXPECT_EQ(cfg->cameras[3].backend, CameraBackend::kSim);
+  EXPECT_EQ(*cfg->pipeline.stages[1].priority, 65);
+  EXPECT_EQ(*cfg->pipeline.detect_camera[3].cpu, -1);
+  EXPECT_EQ(*cfg->pipeline.detect_camera[3].ring_depth, 5u);
+  EXPECT_FALSE(cfg->pipeline.detect_camera[2].cpu.has_value());
 }
 
 TEST(RunConfig, EmptyUdpListDisablesUdp) {

@@ -50,7 +50,7 @@ struct ShortRig {
       EXPECT_TRUE(cams[c]->configure(cfg).ok());
     }
   }
-  std::array<hal::Camera*, 2> cameras() { return {cams[0].get(), cams[1].get()}; }
+  std::vector<hal::Camera*> cameras() { return {cams[0].get(), cams[1].get()}; }
   FrameProcessor processor() const {
     const sim::SimScene& sc = short_loop()->scene();
     auto p = FrameProcessor::create(sc.rig, sc.targets, &sc.joints_true, TrackerConfig{});
@@ -73,7 +73,7 @@ FaultRun run_with_faults(int camera, const std::vector<FaultRule>& rules,
   auto fault = hal::FaultCamera::wrap(*rig.cams[camera], rules, substitute);
   EXPECT_TRUE(fault.ok()) << (fault.ok() ? "" : fault.error().message);
   if (!fault.ok()) return run;
-  std::array<hal::Camera*, 2> cams = rig.cameras();
+  std::vector<hal::Camera*> cams = rig.cameras();
   cams[static_cast<std::size_t>(camera)] = fault->get();
   RecordingSink sink(frames + 8);
   PipelineOptions opt = test_options();

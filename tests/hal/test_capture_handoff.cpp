@@ -11,8 +11,8 @@
 #include <memory>
 #include <thread>
 
-#include "hal/rt/spsc_ring.h"
 #include "hal/v4l2_camera.h"
+#include "rt/spsc_ring.h"
 #include "tests/hal/fake_v4l2.h"
 
 namespace mocap::hal {

@@ -168,6 +168,39 @@ TEST(FramePairer, EveryFrameIsPairedOrHandedBackOnce) {
   EXPECT_EQ(h.pairer.counters().overflow[0].get() + h.pairer.counters().overflow[1].get(), 0u);
 }
 
+TEST(FramePairer, FourCamerasFormSetsAndDropIncompleteOnes) {
+  auto pairer = FramePairer::create({0, 8, 4});
+  ASSERT_TRUE(pairer.ok());
+  EXPECT_FALSE(FramePairer::create({0, 8, 9}).ok());
+  EXPECT_FALSE(FramePairer::create({0, 8, 1}).ok());
+  std::vector<std::pair<int, std::int64_t>> dropped;
+  std::vector<std::int64_t> sets;
+  std::size_t offered = 0;
+  for (std::int64_t s = 0; s < 40; ++s) {
+    for (int c : {2, 0, 3, 1}) {            // any arrival order within a sequence
+      if (c == 3 && s % 10 == 4) continue;  // camera 3 misses every 10th frame
+      FramePair p;
+      ++offered;
+      if (pairer->push(c, {s, static_cast<std::uint32_t>(c)}, p,
+                       [&](int cam, const PairEntry& e) { dropped.emplace_back(cam, e.key); })) {
+        for (int k = 0; k < 4; ++k) {
+          EXPECT_EQ(p.cam[k].key, s);
+          EXPECT_EQ(p.cam[k].handle, static_cast<std::uint32_t>(k));
+        }
+        sets.push_back(s);
+      }
+    }
+  }
+  EXPECT_EQ(sets.size(), 36u);  // 4 of 40 sequences lack camera 3
+  // The other three cameras' frames of each incomplete sequence are dropped once camera 3
+  // has passed them: 3 x 4 frames, each handed back exactly once.
+  EXPECT_EQ(dropped.size(), 12u);
+  for (const auto& d : dropped) EXPECT_EQ(d.second % 10, 4) << d.first;
+  EXPECT_EQ(offered, 4 * sets.size() + dropped.size());
+  EXPECT_EQ(pairer->counters().unmatched[3].get(), 0u);
+  EXPECT_EQ(pairer->counters().unmatched[0].get(), 4u);
+}
+
 TEST(FramePairer, PushAllocatesNothing) {
   auto pairer = FramePairer::create({0, 4});
   ASSERT_TRUE(pairer.ok());

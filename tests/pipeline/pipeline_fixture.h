@@ -1,6 +1,7 @@
 // Shared set-up of the pipeline tests: one short pre-rendered sim loop (process-wide),
-// a simulated stereo pair on it, a FrameProcessor with the scene's true model, and a
-// recording sink that stores messages in preallocated memory (allocation-free).
+// the simulated cameras on it (2 by default, or a loop of 3..8 cameras), a FrameProcessor with the
+// scene's true model, and a recording sink that stores messages in preallocated memory
+// (allocation-free).
 #pragma once
 
 #include <gtest/gtest.h>
@@ -38,9 +39,10 @@ inline std::shared_ptr<const hal::SimFrameLoop> shared_loop() {
 
 // A loop of `frames` frames rendered for one test (a test that needs fewer frames than
 // shared_loop() renders only these, in its own process).
-inline std::shared_ptr<const hal::SimFrameLoop> render_loop(int frames) {
+inline std::shared_ptr<const hal::SimFrameLoop> render_loop(int frames, int cameras = 2) {
   sim::SimOptions o;
   o.frames = frames;
+  o.cameras = cameras;  // 3..8: the built-in arc around the robot
   auto l = hal::SimFrameLoop::render(o);
   EXPECT_TRUE(l.ok()) << (l.ok() ? "" : l.error().message);
   return l.ok() ? *l : nullptr;
@@ -49,22 +51,26 @@ inline std::shared_ptr<const hal::SimFrameLoop> render_loop(int frames) {
 struct SimRigFixture {
   std::shared_ptr<const hal::SimFrameLoop> loop;
   std::shared_ptr<hal::SimTrigger> trigger;
-  std::unique_ptr<hal::SimCamera> cams[2];
+  std::vector<std::unique_ptr<hal::SimCamera>> cams;  // every camera of the loop
 
   // `frames`: the loop to serve (default: shared_loop()).
   explicit SimRigFixture(int buffers = 6, std::shared_ptr<const hal::SimFrameLoop> frames = {})
       : loop(frames ? std::move(frames) : shared_loop()) {
     trigger = std::make_shared<hal::SimTrigger>(loop);
-    for (int c = 0; c < 2; ++c) {
+    for (int c = 0; c < loop->cameras(); ++c) {
       auto cam = hal::SimCamera::open(trigger, c);
       EXPECT_TRUE(cam.ok());
-      cams[c] = std::move(cam).value();
-      hal::CameraConfig cfg = cams[c]->native_config();
+      cams.push_back(std::move(cam).value());
+      hal::CameraConfig cfg = cams.back()->native_config();
       cfg.buffer_count = buffers;
-      EXPECT_TRUE(cams[c]->configure(cfg).ok());
+      EXPECT_TRUE(cams.back()->configure(cfg).ok());
     }
   }
-  std::array<hal::Camera*, 2> cameras() { return {cams[0].get(), cams[1].get()}; }
+  std::vector<hal::Camera*> cameras() {
+    std::vector<hal::Camera*> v;
+    for (auto& c : cams) v.push_back(c.get());
+    return v;
+  }
   FrameProcessor processor() const {
     const sim::SimScene& sc = loop->scene();
     // The pipeline tests check the plumbing (every frame, in order, true angles), so they

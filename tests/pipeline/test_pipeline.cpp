@@ -173,28 +173,64 @@ class AllocationHooks final : public StageHooks {
   bool ended(StageId s) const { return ended_[index(s)].load(std::memory_order_acquire); }
 
  private:
-  std::array<std::uint64_t, kStageCount> start_{}, allocations_{};
-  std::array<std::atomic<bool>, kStageCount> ended_{};
+  std::array<std::uint64_t, kMaxStages> start_{}, allocations_{};
+  std::array<std::atomic<bool>, kMaxStages> ended_{};
 };
 
-TEST(Pipeline, StageThreadsDoNotAllocate) {
-  SimRigFixture rig;
+// Every stage thread of a pipeline over `rig`'s cameras ran and allocated nothing.
+void expect_stage_threads_do_not_allocate(SimRigFixture& rig, std::uint64_t frames) {
   RecordingSink sink(1000);
   AllocationHooks hooks;
   PipelineOptions opt = test::test_options();
   opt.hooks = &hooks;
-  opt.max_frames = 100;
+  opt.max_frames = frames;
   auto p = Pipeline::create(rig.processor(), rig.cameras(), {&sink}, opt);
-  ASSERT_TRUE(p.ok());
+  ASSERT_TRUE(p.ok()) << p.error().message;
   ASSERT_TRUE((*p)->start().ok());
   test::wait_finished(**p);
   (*p)->stop();
-  EXPECT_GT(sink.count(), 50u);
-  for (std::size_t s = 0; s < kStageCount; ++s) {
-    const auto id = static_cast<StageId>(s);
-    ASSERT_TRUE(hooks.ended(id));
-    EXPECT_EQ(hooks.allocations(id), 0u) << kDefaultStages[s].name;
+  EXPECT_GT(sink.count(), frames / 2);
+  std::vector<StageId> ids = {StageId::kCapture, StageId::kIdentify, StageId::kPublish};
+  for (int c = 0; c < (*p)->camera_count(); ++c) ids.push_back(StageId::detect(c));
+  for (StageId id : ids) {
+    ASSERT_TRUE(hooks.ended(id)) << (*p)->stage(id).name;
+    EXPECT_EQ(hooks.allocations(id), 0u) << (*p)->stage(id).name;
   }
+}
+
+TEST(Pipeline, StageThreadsDoNotAllocate) {
+  SimRigFixture rig;
+  expect_stage_threads_do_not_allocate(rig, 100);
+}
+
+TEST(Pipeline, FourCameraStageThreadsDoNotAllocate) {
+  SimRigFixture rig(6, test::render_loop(4, 4));  // a short 4-camera loop
+  ASSERT_EQ(rig.cams.size(), 4u);
+  expect_stage_threads_do_not_allocate(rig, 30);
+}
+
+TEST(Pipeline, DetectStagesFollowTheTableRule) {
+  SimRigFixture rig(6, test::render_loop(2, 4));
+  RecordingSink sink(10);
+  PipelineOptions opt = test::test_options();
+  opt.cpu_count = 2;
+  opt.stages.detect[3].cpu = -1;  // one camera's override
+  auto p = Pipeline::create(rig.processor(), rig.cameras(), {&sink}, opt);
+  ASSERT_TRUE(p.ok()) << p.error().message;
+  const StageSpec& rule = kDefaultStages[static_cast<std::size_t>(StageKind::kDetect)];
+  for (int c = 0; c < 3; ++c) {
+    const ResolvedStage& s = (*p)->stage(StageId::detect(c));
+    EXPECT_EQ(s.name, "mocap-detect" + std::to_string(c));
+    EXPECT_EQ(s.cpu, (rule.cpu + c) % 2);
+    EXPECT_EQ(s.fifo_priority, rule.fifo_priority);
+  }
+  EXPECT_EQ((*p)->stage(StageId::detect(3)).cpu, -1);
+  // The camera count must be the rig's.
+  std::vector<hal::Camera*> three = rig.cameras();
+  three.pop_back();
+  auto q = Pipeline::create(rig.processor(), three, {&sink}, opt);
+  ASSERT_FALSE(q.ok());
+  EXPECT_NE(q.error().message.find("the rig has 4"), std::string::npos) << q.error().message;
 }
 
 TEST(Pipeline, HealthCountersOnlyGrow) {
@@ -235,7 +271,7 @@ TEST(Pipeline, SetupErrorsAreOneLine) {
 
   SimRigFixture rig2;
   PipelineOptions bad = test::test_options();
-  bad.stages[index(StageId::kIdentify)].ring_depth = 1;
+  bad.stages[StageKind::kIdentify].ring_depth = 1;
   auto q = Pipeline::create(rig2.processor(), rig2.cameras(), {&sink}, bad);
   ASSERT_FALSE(q.ok());
   EXPECT_NE(q.error().message.find("ring_depth"), std::string::npos);

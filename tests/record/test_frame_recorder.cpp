@@ -19,10 +19,10 @@ namespace {
 
 constexpr int kW = 64, kH = 48;
 
-// A 2-camera rig of kW x kH cameras (for Recording::open).
-void write_rig(const std::string& dir) {
+// A rig of `cameras` kW x kH cameras (for Recording::open).
+void write_rig(const std::string& dir, int cameras = 2) {
   Rig rig;
-  for (int c = 0; c < 2; ++c) {
+  for (int c = 0; c < cameras; ++c) {
     CameraModel m;
     m.name = "cam" + std::to_string(c);
     m.width = kW;
@@ -113,6 +113,41 @@ TEST(FrameRecorder, WritesEveryFrameLosslesslyAndReadsBack) {
       }
     }
   }
+}
+
+TEST(FrameRecorder, ThreeCamerasOneFolderEachAndOneRowPerFrame) {
+  test::TempDir dir("rec_three");
+  write_rig(dir.path(), 3);
+  RecorderOptions o = options(dir.path());
+  o.camera_names.push_back("cam2");
+  o.cameras.push_back(CameraGeometry{kW, kH, PixelFormat::kMono8});
+  o.wait_for_slot_ms = 5000;
+  auto rec = FrameRecorder::create(o);
+  ASSERT_TRUE(rec) << rec.error().message;
+  (*rec)->start();
+  for (std::uint64_t s = 0; s < 6; ++s) {
+    for (int c = 0; c < 3; ++c) {
+      if (s == 3 && c == 2) continue;  // camera 2 dropped frame 3: the others' images stay
+      const Image im = pattern(c, s);
+      (*rec)->on_frame(c, frame_of(im, s));
+    }
+  }
+  ASSERT_TRUE((*rec)->finish());
+  EXPECT_EQ((*rec)->counts().frames_written, 6u);
+  EXPECT_EQ((*rec)->counts().images_written, 17u);
+  EXPECT_EQ((*rec)->counts().not_written, 0u);
+  ASSERT_EQ((*rec)->counts().dropped.size(), 3u);
+  auto r = Recording::open(dir.path());
+  ASSERT_TRUE(r) << r.error().message;
+  ASSERT_EQ(r->frames().size(), 6u);
+  Image got;
+  auto load = r->load_frame(2, 3, got);
+  ASSERT_TRUE(load) << load.error().message;
+  EXPECT_EQ(*load, FrameLoad::kMissing);
+  load = r->load_frame(1, 3, got);
+  ASSERT_TRUE(load) << load.error().message;
+  ASSERT_EQ(*load, FrameLoad::kOk);
+  EXPECT_TRUE(same_pixels(got, pattern(1, 3)));
 }
 
 TEST(FrameRecorder, DropsAndCountsWhenTheWriterIsBehind) {

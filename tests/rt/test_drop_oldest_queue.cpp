@@ -6,7 +6,7 @@
 #include <array>
 #include <cstdint>
 
-#include "hal/rt/drop_oldest_queue.h"
+#include "rt/drop_oldest_queue.h"
 #include "tests/support/alloc_counter.h"
 
 namespace mocap::rt {

@@ -10,7 +10,7 @@
 #include <cstdint>
 #include <thread>
 
-#include "hal/rt/drop_oldest_queue.h"
+#include "rt/drop_oldest_queue.h"
 
 namespace mocap::rt {
 namespace {

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "core/image.h"
-#include "hal/rt/slot_pool.h"
+#include "rt/slot_pool.h"
 #include "tests/support/alloc_counter.h"
 
 namespace mocap::rt {

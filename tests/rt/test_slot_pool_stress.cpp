@@ -11,7 +11,7 @@
 #include <thread>
 #include <vector>
 
-#include "hal/rt/slot_pool.h"
+#include "rt/slot_pool.h"
 
 namespace mocap::rt {
 namespace {

@@ -4,7 +4,7 @@
 
 #include <cstdint>
 
-#include "hal/rt/spsc_ring.h"
+#include "rt/spsc_ring.h"
 #include "tests/support/alloc_counter.h"
 
 namespace mocap::rt {

@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <thread>
 
-#include "hal/rt/spsc_ring.h"
+#include "rt/spsc_ring.h"
 
 namespace mocap::rt {
 namespace {

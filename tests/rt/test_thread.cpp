@@ -8,7 +8,7 @@
 #include <atomic>
 #include <cstring>
 
-#include "hal/rt/thread.h"
+#include "rt/thread.h"
 
 namespace mocap::rt {
 namespace {

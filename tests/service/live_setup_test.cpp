@@ -24,17 +24,22 @@ TEST(LiveSetup, StageNamesMatchThePipelineTable) {
 
 TEST(LiveSetup, StageOverridesOnTopOfTheDefaultTable) {
   config::RunConfig cfg = config::default_run_config();
-  cfg.pipeline.stages[3].cpu = 0;
-  cfg.pipeline.stages[3].ring_depth = 8;
-  cfg.pipeline.stages[4].priority = 0;
+  cfg.pipeline.stages[2].cpu = 0;  // identify
+  cfg.pipeline.stages[2].ring_depth = 8;
+  cfg.pipeline.stages[3].priority = 0;           // publish
+  cfg.pipeline.detect_camera[1].ring_depth = 6;  // detect1 only
   cfg.pipeline.pacing = config::Pacing::kLockstep;
   cfg.pipeline.trigger_rate_hz = 250.0;
   const pipeline::PipelineOptions o = pipeline_options(cfg);
-  EXPECT_EQ(o.stages[3].cpu, 0);
-  EXPECT_EQ(o.stages[3].ring_depth, 8u);
-  EXPECT_EQ(o.stages[3].fifo_priority, pipeline::kDefaultStages[3].fifo_priority);
-  EXPECT_EQ(o.stages[4].fifo_priority, 0);
-  EXPECT_EQ(o.stages[1].cpu, pipeline::kDefaultStages[1].cpu);
+  using pipeline::StageKind;
+  EXPECT_EQ(o.stages[StageKind::kIdentify].cpu, 0);
+  EXPECT_EQ(o.stages[StageKind::kIdentify].ring_depth, 8u);
+  EXPECT_EQ(o.stages[StageKind::kIdentify].fifo_priority,
+            pipeline::kDefaultStages[2].fifo_priority);
+  EXPECT_EQ(o.stages[StageKind::kPublish].fifo_priority, 0);
+  EXPECT_EQ(o.stages[StageKind::kDetect].cpu, pipeline::kDefaultStages[1].cpu);
+  EXPECT_EQ(o.stages.detect[1].ring_depth, 6u);
+  EXPECT_EQ(o.stages.detect[0].ring_depth, 0u);  // unset: the rule's
   EXPECT_EQ(o.pacing, pipeline::TriggerPacing::kLockstep);
   EXPECT_DOUBLE_EQ(o.trigger_rate_hz, 250.0);
 }
@@ -131,7 +136,7 @@ TEST(LiveSetup, ReplayCamerasConfiguredFromTheFile) {
   auto cfg = config::load_run_config(dir.file("m.yaml"));
   ASSERT_TRUE(cfg) << cfg.error().message;
   cfg->cameras[0].buffers = 9;
-  cfg->pipeline.stages[2].ring_depth = 5;  // detect1
+  cfg->pipeline.detect_camera[1].ring_depth = 5;  // detect1
   auto setup = LiveSetup::create(*cfg, nullptr);
   ASSERT_TRUE(setup) << setup.error().message;
   const auto cams = (*setup)->cameras();
@@ -140,7 +145,7 @@ TEST(LiveSetup, ReplayCamerasConfiguredFromTheFile) {
   EXPECT_EQ(cams[0]->config().trigger, hal::TriggerMode::kSoftware);
   EXPECT_EQ(cams[0]->config().width, 64);
   EXPECT_EQ(cams[0]->state(), hal::CameraState::kConfigured);
-  EXPECT_EQ((*setup)->options().stages[2].ring_depth, 5u);
+  EXPECT_EQ((*setup)->options().stages.detect[1].ring_depth, 5u);
   FrameProcessor proc = (*setup)->take_processor();
   EXPECT_FALSE(proc.has_model());  // no model in the file: poses only
 }

@@ -1,6 +1,6 @@
 // Design: see thread.h. pthread calls return an errno value; each failure becomes a
 // clause of the one-line note ("cpu 3: Invalid argument: not pinned").
-#include "hal/rt/thread.h"
+#include "rt/thread.h"
 
 #include <pthread.h>
 #include <sched.h>

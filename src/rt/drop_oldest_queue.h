@@ -34,8 +34,8 @@
 #include <type_traits>
 
 #include "core/expected.h"
-#include "hal/rt/counter.h"
-#include "hal/rt/spsc_ring.h"
+#include "rt/counter.h"
+#include "rt/spsc_ring.h"
 
 namespace mocap::rt {
 

@@ -27,8 +27,8 @@
 #include <vector>
 
 #include "core/expected.h"
-#include "hal/rt/counter.h"
-#include "hal/rt/spsc_ring.h"
+#include "rt/counter.h"
+#include "rt/spsc_ring.h"
 
 namespace mocap::rt {
 
