@@ -19,6 +19,11 @@
 
 namespace mocap::test {
 
+// Angle of the rotation between two rotation matrices (degrees).
+inline double rotation_error_deg(const Mat3& a, const Mat3& b) {
+  return Eigen::AngleAxisd(a * b.transpose()).angle() * 180.0 / 3.14159265358979323846;
+}
+
 // The test wand: three balls at 0, 110 and 300 mm along the bar.
 inline WandSpec test_wand() {
   WandSpec w;

@@ -15,10 +15,6 @@ using test::cam0_world;
 using test::synthetic_wand_blobs;
 using test::true_cameras;
 
-double rot_err_deg(const Mat3& a, const Mat3& b) {
-  return Eigen::AngleAxisd(a * b.transpose()).angle() * 180.0 / 3.14159265358979323846;
-}
-
 // Frames with every marker in both images, in wand order (no strays in these blobs).
 void make_frames(const std::vector<CameraModel>& cams, int n, std::vector<WandFrame>& frames,
                  std::vector<WandPose>& poses) {
@@ -61,10 +57,10 @@ TEST(Bundle, ConvergesFromPerturbedExtrinsics) {
   ASSERT_TRUE(
       bundle_adjust(mocap::test::test_wand(), frames, use_ref, ref, poses_ref, BundleOptions{}));
   EXPECT_LT((cams[1].center_world() - ref[1].center_world()).norm(), 1e-4);
-  EXPECT_LT(rot_err_deg(cams[1].R_cam_world, ref[1].R_cam_world), 1e-6);
+  EXPECT_LT(test::rotation_error_deg(cams[1].R_cam_world, ref[1].R_cam_world), 1e-6);
   // ... which is close to the truth (0.05 px noise, 80 frames).
   EXPECT_LT((cams[1].center_world() - truth[1].center_world()).norm(), 0.3);
-  EXPECT_LT(rot_err_deg(cams[1].R_cam_world, truth[1].R_cam_world), 0.01);
+  EXPECT_LT(test::rotation_error_deg(cams[1].R_cam_world, truth[1].R_cam_world), 0.01);
   EXPECT_LT(st->rms_px[0], 0.08);
   EXPECT_LT(st->rms_px[1], 0.08);
   EXPECT_GT(st->rms_px[0], 0.02);  // the noise is really there
@@ -103,7 +99,7 @@ TEST(RigCalibrator, CalibratesFromBlobsWithStrays) {
   auto r = calibrate_from_blobs(blobs, mocap::test::test_wand(), world, opt, "rec");
   ASSERT_TRUE(r) << r.error().message;
   EXPECT_NEAR(r->baseline_mm, truth[1].center_world().norm(), 0.1);
-  EXPECT_LT(rot_err_deg(r->cameras[1].R_cam_world, truth[1].R_cam_world), 0.01);
+  EXPECT_LT(test::rotation_error_deg(r->cameras[1].R_cam_world, truth[1].R_cam_world), 0.01);
   EXPECT_LT(r->wand_length_rms_error_mm, 0.3);
   EXPECT_GT(r->frames_used, 60);
   EXPECT_FALSE(r->intrinsics_refined);
@@ -163,7 +159,8 @@ TEST(GroundFrame, FromLFrameObservations) {
   const Rig expected = sim::rig_in_lframe(Rig{{truth_world[0], truth_world[1]}}, T_world_lframe);
   for (std::size_t c = 0; c < 2; ++c) {
     EXPECT_LT((res.cameras[c].center_world() - expected.cameras[c].center_world()).norm(), 0.5);
-    EXPECT_LT(rot_err_deg(res.cameras[c].R_cam_world, expected.cameras[c].R_cam_world), 0.02);
+    EXPECT_LT(test::rotation_error_deg(res.cameras[c].R_cam_world, expected.cameras[c].R_cam_world),
+              0.02);
   }
   EXPECT_LT(res.ground.rms_mm, 0.1);
   // The wrong L-frame layout is an error.

@@ -18,10 +18,6 @@ using test::cam0_world;
 using test::ring_cameras;
 using test::ring_wand_blobs;
 
-double rot_err_deg(const Mat3& a, const Mat3& b) {
-  return Eigen::AngleAxisd(a * b.transpose()).angle() * 180.0 / 3.14159265358979323846;
-}
-
 // Assumed for the acceptance (0.1 mm, 0.01 degrees): Gaussian pixel noise of 0.05 px
 // per axis on every marker centre (a well-focused ~10 px marker, subpixel centroid),
 // 1000 wand frames (~30 s of waving at 30 fps), the true intrinsics (kFixed). The
@@ -46,7 +42,8 @@ TEST(RigCalibratorN, FourCameraRingWithinAcceptance) {
   EXPECT_GT(r->frames_used, 800);
   for (std::size_t c = 1; c < 4; ++c) {
     const double pos_mm = (r->cameras[c].center_world() - truth[c].center_world()).norm();
-    const double rot_deg = rot_err_deg(r->cameras[c].R_cam_world, truth[c].R_cam_world);
+    const double rot_deg =
+        test::rotation_error_deg(r->cameras[c].R_cam_world, truth[c].R_cam_world);
     std::printf(
         "[ ring4 ] %s: baseline %.1f mm, centre error %.4f mm, rotation error %.5f deg, "
         "RMS %.3f px, %d frames used, from %s\n",
@@ -84,7 +81,7 @@ TEST(RigCalibratorN, ChainsThroughTheBestConnectedCamera) {
   // statistical error is larger than in the acceptance case).
   for (std::size_t c = 1; c < 4; ++c) {
     EXPECT_LT((r->cameras[c].center_world() - truth[c].center_world()).norm(), 0.5);
-    EXPECT_LT(rot_err_deg(r->cameras[c].R_cam_world, truth[c].R_cam_world), 0.01);
+    EXPECT_LT(test::rotation_error_deg(r->cameras[c].R_cam_world, truth[c].R_cam_world), 0.01);
   }
 }
 
@@ -154,7 +151,8 @@ TEST(GroundFrame, FromLFrameObservationsFourCameras) {
   // (~0.01 degrees) moves their centres by up to ~0.8 mm.
   for (std::size_t c = 0; c < 4; ++c) {
     EXPECT_LT((res.cameras[c].center_world() - expected.cameras[c].center_world()).norm(), 1.0);
-    EXPECT_LT(rot_err_deg(res.cameras[c].R_cam_world, expected.cameras[c].R_cam_world), 0.02);
+    EXPECT_LT(test::rotation_error_deg(res.cameras[c].R_cam_world, expected.cameras[c].R_cam_world),
+              0.02);
   }
   EXPECT_LT(res.ground.rms_mm, 0.1);
 }
