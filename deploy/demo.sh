@@ -3,7 +3,8 @@
 # simulated default: renders recordings of the built-in shoulder rig with ground truth,
 # calibrates the joints, tracks offline through the same stages as the live pipeline
 # (printing the accuracy against the ground truth and the per-stage timings), then runs
-# the live pipeline on simulated cameras for 5 s and prints its latency statistics.
+# the live pipeline on simulated cameras for 5 s and prints its latency statistics; then
+# the same with 4 cameras around the robot (offline tracking and 3 s of the live pipeline).
 # This is the README's first command.
 # Usage: bash deploy/demo.sh [OUTPUT_DIR]     (default: ./out/demo)
 set -euo pipefail
@@ -31,3 +32,10 @@ echo "== mocap track"
 echo "== outputs in $out/track: points.csv poses.csv angles.csv stats.json"
 echo "== mocap run (live pipeline on simulated cameras, UDP to 127.0.0.1:7755, 5 s)"
 "$mocap" run --duration 5 --stats "$out/run-stats.json"
+echo "== 4 cameras around the robot: mocap simulate --cameras 4, mocap track (same robot and model)"
+"$mocap" simulate --out "$out/rec4" --frames 100 --motion smooth --cameras 4
+"$mocap" track "$out/rec4" --targets "$out/rec4/targets.yaml" --model "$out/model.yaml" \
+  --out "$out/track4" --truth "$out/rec4/gt"
+echo "== mocap run on 4 simulated cameras (a 60-frame loop, 3 s)"
+printf 'sim:\n  cameras: 4\n  loop_frames: 60\n' >"$out/run4.yaml"
+"$mocap" run --config "$out/run4.yaml" --duration 3 --stats-interval 0

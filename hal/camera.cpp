@@ -59,18 +59,4 @@ const char* to_string(TriggerMode m) noexcept {
   return "unknown";
 }
 
-void sleep_until_ns(std::int64_t deadline_ns) noexcept {
-  timespec ts{};
-  ts.tv_sec = deadline_ns / 1'000'000'000;
-  ts.tv_nsec = deadline_ns % 1'000'000'000;
-  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) != 0) {
-  }
-}
-
-std::int64_t monotonic_ns() noexcept {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
-
 }  // namespace mocap::hal

@@ -22,17 +22,15 @@
 #include <cstdint>
 #include <string>
 
+#include "core/capture_modes.h"
+#include "core/clock.h"
 #include "core/expected.h"
 #include "core/image.h"
 #include "rt/counter.h"
 
 namespace mocap::hal {
 
-enum class TriggerMode : std::uint8_t {
-  kFreeRun,   // the camera runs at frame_rate_hz
-  kExternal,  // a hardware trigger line starts each exposure (both cameras share it)
-  kSoftware,  // each trigger() call starts one exposure
-};
+using mocap::TriggerMode;  // core/capture_modes.h
 
 enum class CameraState : std::uint8_t { kClosed, kConfigured, kStreaming, kError };
 
@@ -120,10 +118,8 @@ class Camera {
   virtual const CameraCounters& counters() const noexcept = 0;
 };
 
-// CLOCK_MONOTONIC in ns (the clock of every timestamp in the HAL and the live output).
-std::int64_t monotonic_ns() noexcept;
-// Sleeps until an absolute CLOCK_MONOTONIC deadline (no drift over long runs; restarts
-// after signals).
-void sleep_until_ns(std::int64_t deadline_ns) noexcept;
+// The clock of every timestamp in the HAL and the live output (core/clock.h).
+using mocap::monotonic_ns;
+using mocap::sleep_until_ns;
 
 }  // namespace mocap::hal

@@ -1,10 +1,9 @@
 // Design: see pipeline.h. This file is the setup and lifecycle: create() validates the
-// options, start() allocates every ring and slot and starts the cameras and the five
-// threads, stop() joins them and returns every buffer; retire()/finished() keep the
-// count of sequences the pipeline is done with. Setup may allocate and fails with
-// one-line errors. The threads' settings come from the stage table (resolve_stage(): the
-// detect rule per camera) and are fixed at create(). The stage loops (the hot path) are in
-// capture_stage.cpp and processing_stages.cpp, the reports (health(), stats()) in
+// options, start() builds the stages (every ring and slot), starts the cameras and one
+// thread per stage, stop() joins them and returns every buffer. Setup may allocate and
+// fails with one-line errors. The threads' settings come from the stage table
+// (resolve_stage(): the detect rule per camera) and are fixed at create(). The stage
+// loops (the hot path) are in the stage files, the reports (health(), stats()) in
 // pipeline_stats.cpp.
 #include "pipeline/pipeline.h"
 
@@ -37,8 +36,9 @@ Expected<std::unique_ptr<Pipeline>> Pipeline::create(FrameProcessor processor,
   for (const publish::OutputSink* s : sinks) {
     if (s == nullptr) return make_error("pipeline", "sinks", "null sink");
   }
-  // Lower bound: the period 1e9 / rate must fit the int64 nanoseconds of the capture loop.
-  if (!(options.trigger_rate_hz >= 0.01) || options.trigger_rate_hz > 10000.0) {
+  // The configuration's range (core/capture_modes.h): here for callers without one.
+  if (!(options.trigger_rate_hz >= kMinTriggerRateHz &&
+        options.trigger_rate_hz <= kMaxTriggerRateHz)) {
     return make_error("pipeline", "trigger_rate_hz",
                       "must be in [0.01, 10000], got " + std::to_string(options.trigger_rate_hz));
   }
@@ -79,67 +79,39 @@ Pipeline::Pipeline(FrameProcessor processor, std::vector<hal::Camera*> cameras,
 
 Pipeline::~Pipeline() { stop(); }
 
+Expected<void> Pipeline::build_stages() {
+  const int n = camera_count();
+  capture_.reset();
+  detect_.clear();
+  identify_.reset();
+  publish_.reset();
+  auto publish = PublishStage::create(stage(StageId::kPublish).ring_depth, context_, sinks_);
+  if (!publish) return publish.error();
+  publish_ = std::move(publish).value();
+  auto identify = IdentifyStage::create(stage(StageId::kIdentify).ring_depth, context_, processor_,
+                                        publish_->input());
+  if (!identify) return identify.error();
+  identify_ = std::move(identify).value();
+  for (int c = 0; c < n; ++c) {
+    const hal::Camera& cam = *cameras_[static_cast<std::size_t>(c)];
+    auto d = DetectStage::create(c, cam, stage(StageId::detect(c)).ring_depth, context_, processor_,
+                                 identify_->input(c));
+    if (!d) return d.error();
+    detect_.push_back(std::move(d).value());
+  }
+  return {};  // the capture stage is built once the cameras run (start())
+}
+
 Expected<void> Pipeline::start() {
   if (running_) return make_error("pipeline", "start", "already running");
   notes_.clear();
-  const int n = camera_count();
-  // Camera buffers: the detect ring, one in the detector's hand, one on its way back.
-  for (int c = 0; c < n; ++c) {
-    hal::Camera& cam = *cameras_[static_cast<std::size_t>(c)];
-    const std::uint32_t depth = stage(StageId::detect(c)).ring_depth;
-    if (cam.config().buffer_count < static_cast<int>(depth) + 2) {
-      return make_error(
-          cam.name(), "buffer_count",
-          std::to_string(cam.config().buffer_count) +
-              " buffers; the pipeline needs detect ring_depth + 2 = " + std::to_string(depth + 2));
-    }
-  }
-  to_detect_.clear();
-  returned_.clear();
-  blob_pools_.clear();
-  for (int c = 0; c < n; ++c) {
-    hal::Camera& cam = *cameras_[static_cast<std::size_t>(c)];
-    const std::uint32_t depth = stage(StageId::detect(c)).ring_depth;
-    to_detect_.push_back(
-        std::make_unique<rt::SpscRing<hal::Frame>>(rt::next_power_of_two_at_least(depth)));
-    returned_.push_back(std::make_unique<rt::SpscRing<hal::Frame>>(
-        rt::next_power_of_two_at_least(static_cast<std::size_t>(cam.config().buffer_count))));
-    const FrameOutput proto = processor_.make_output();
-    auto pool = rt::SlotPool<BlobSlot>::create(stage(StageId::kIdentify).ring_depth + 2,
-                                               [&](std::uint32_t) {
-                                                 BlobSlot s;
-                                                 s.blobs = proto.blobs[static_cast<std::size_t>(c)];
-                                                 return s;
-                                               });
-    if (!pool) return pool.error();
-    blob_pools_.push_back(std::make_unique<rt::SlotPool<BlobSlot>>(std::move(pool).value()));
-  }
-  auto msg_pool = rt::SlotPool<MsgSlot>::create(stage(StageId::kPublish).ring_depth + 2,
-                                                [](std::uint32_t) { return MsgSlot{}; });
-  if (!msg_pool) return msg_pool.error();
-  msg_pool_ = std::make_unique<rt::SlotPool<MsgSlot>>(std::move(msg_pool).value());
-  const std::int64_t tolerance =
-      options_.pair_by == PairBy::kTimestamp ? options_.pair_tolerance_us * 1000 : 0;
-  auto pairer = hal::FramePairer::create(
-      hal::PairerConfig{tolerance, stage(StageId::kIdentify).ring_depth, n});
-  if (!pairer) return pairer.error();
-  pairer_ = std::make_unique<hal::FramePairer>(std::move(pairer).value());
-  out_ = std::make_unique<FrameOutput>(processor_.make_output());
-  counters_ = std::make_unique<Counters>();
-  lat_ = std::make_unique<Latencies>();  // value-initialised: every bucket 0
-  lat_->sink_work_each = std::make_unique<LatencyHistogram[]>(sinks_.size());
+  if (auto built = build_stages(); !built) return built;
   processor_.reset();
-  stop_.store(false, std::memory_order_relaxed);  // no thread runs yet
-  triggering_done_.store(false, std::memory_order_relaxed);
-  published_.store(0, std::memory_order_relaxed);
-  last_publish_ns_.store(0, std::memory_order_relaxed);
-  retired_.store(0, std::memory_order_relaxed);
-  publish_period_ns_.store(0, std::memory_order_relaxed);
-  first_sequence_.store(0, std::memory_order_relaxed);
-
+  context_.reset();  // no thread runs yet
   if (options_.lock_memory) {
     if (std::string note = rt::lock_memory(); !note.empty()) notes_.push_back(note);
   }
+  const int n = camera_count();
   for (int c = 0; c < n; ++c) {
     if (auto r = cameras_[static_cast<std::size_t>(c)]->start(); !r) {
       for (int started = 0; started < c; ++started)
@@ -147,13 +119,18 @@ Expected<void> Pipeline::start() {
       return r.error();
     }
   }
+  // The cameras' silence counts from here (the stage was built before the cameras started).
+  capture_ = std::make_unique<CaptureStage>(context_, cameras_, detect_pointers(), monotonic_ns());
   start_ns_ = monotonic_ns();
   stop_ns_ = 0;
-  for (auto& t : last_frame_ns_) t.store(0, std::memory_order_relaxed);  // no frame yet
+  return start_threads();
+}
+
+Expected<void> Pipeline::start_threads() {
   threads_.clear();
   // Consumers first, so that no producer ever runs ahead of a missing consumer.
   std::vector<StageId> order = {StageId::kPublish, StageId::kIdentify};
-  for (int c = 0; c < n; ++c) order.push_back(StageId::detect(c));
+  for (int c = 0; c < camera_count(); ++c) order.push_back(StageId::detect(c));
   order.push_back(StageId::kCapture);
   for (StageId id : order) {
     const ResolvedStage& s = stage(id);
@@ -162,16 +139,16 @@ Expected<void> Pipeline::start() {
     std::function<void()> body;
     switch (id.kind) {
       case StageKind::kCapture:
-        body = [this] { capture_loop(); };
+        body = [this] { capture_->run(); };
         break;
       case StageKind::kDetect:
-        body = [this, c = id.camera] { detect_loop(c); };
+        body = [d = detect_[static_cast<std::size_t>(id.camera)].get()] { d->run(); };
         break;
       case StageKind::kIdentify:
-        body = [this] { identify_loop(); };
+        body = [this] { identify_->run(); };
         break;
       case StageKind::kPublish:
-        body = [this] { publish_loop(); };
+        body = [this] { publish_->run(); };
         break;
     }
     auto t = rt::start_thread(spec, std::move(body));
@@ -187,56 +164,32 @@ Expected<void> Pipeline::start() {
   return {};
 }
 
+std::vector<DetectStage*> Pipeline::detect_pointers() const {
+  std::vector<DetectStage*> out;
+  for (const auto& d : detect_) out.push_back(d.get());
+  return out;
+}
+
 void Pipeline::stop() noexcept {
   if (!running_) return;
-  // release: the stage threads' acquire loads see everything before the stop request.
-  stop_.store(true, std::memory_order_release);
-  for (Doorbell& b : bells_) b.ring();
+  context_.request_stop();
   // Producers first: capture, then detectors, then identify, then publish.
   for (auto it = threads_.rbegin(); it != threads_.rend(); ++it) {
     if (it->joinable()) it->join();
   }
   threads_.clear();
   stop_ns_ = monotonic_ns();
-  drain_after_join();
+  // Every thread is joined: this thread now owns every ring end.
+  capture_->drain();
+  identify_->drain();
+  publish_->drain();
   for (hal::Camera* cam : cameras_) cam->stop();
   running_ = false;
 }
 
-void Pipeline::drain_after_join() noexcept {
-  // Every thread is joined: this thread now owns every ring end.
-  for (int c = 0; c < camera_count(); ++c) {
-    hal::Frame f;
-    while (to_detect_[static_cast<std::size_t>(c)]->try_pop(f))
-      cameras_[static_cast<std::size_t>(c)]->release(f);
-  }
-  release_returned();
-  pairer_->flush([&](int c, const hal::PairEntry& e) {
-    blob_pools_[static_cast<std::size_t>(c)]->release(e.handle);
-  });
-  for (auto& pool : blob_pools_) {
-    rt::SlotHandle h;
-    while (pool->pop(h)) pool->release(h);
-  }
-  rt::SlotHandle h;
-  while (msg_pool_->pop(h)) msg_pool_->release(h);
-}
-
 bool Pipeline::finished() const noexcept {
-  // acquire: pairs with the capture thread's release store after its last trigger.
-  if (!counters_ || !triggering_done_.load(std::memory_order_acquire)) return false;
-  return retired_.load(std::memory_order_acquire) >= counters_->triggered.get() || stopping();
-}
-
-void Pipeline::retire(std::uint64_t sequence) noexcept {
-  // acq_rel CAS loop (two writers: identify and publish): the capture thread's acquire
-  // load in lockstep sees a value only ever growing.
-  std::uint64_t cur = retired_.load(std::memory_order_relaxed);
-  while (cur < sequence + 1 &&
-         !retired_.compare_exchange_weak(cur, sequence + 1, std::memory_order_acq_rel,
-                                         std::memory_order_relaxed)) {
-  }
-  bells_[index(StageId::kCapture)].ring();
+  if (!capture_ || !context_.triggering_done()) return false;  // acquire: see there
+  return context_.retired_plus_one() >= capture_->end_sequence() || context_.stopping();
 }
 
 }  // namespace mocap::pipeline

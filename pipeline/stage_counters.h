@@ -147,17 +147,17 @@ template <std::size_t... I>
 constexpr std::array<CounterField<ChainCounters>, 2 * sizeof...(I)> make_coverage_fields(
     std::index_sequence<I...>) noexcept {
   std::array<CounterField<ChainCounters>, 2 * sizeof...(I)> f{};
-  ((f[2 * I] = {"poses", [](const ChainCounters& s) noexcept -> std::uint64_t {
-                  return s.joint_poses[I];
-                }},
-    f[2 * I + 1] = {"chain", [](const ChainCounters& s) noexcept -> std::uint64_t {
+  ((f[2 * I] = {"poses",
+                [](const ChainCounters& s) noexcept -> std::uint64_t { return s.joint_poses[I]; }},
+    f[2 * I + 1] = {"chain",
+                    [](const ChainCounters& s) noexcept -> std::uint64_t {
                       return s.joint_chain[I];
                     }}),
    ...);
   return f;
 }
-inline constexpr auto kCoverageFields =
-    make_coverage_fields(std::make_index_sequence<std::tuple_size_v<decltype(ChainCounters::joint_poses)>>{});
+inline constexpr auto kCoverageFields = make_coverage_fields(
+    std::make_index_sequence<std::tuple_size_v<decltype(ChainCounters::joint_poses)>>{});
 
 using DetectorMirror = CounterMirror<detect::DetectorCounters, kDetectorFields.size()>;
 using StereoMirror = CounterMirror<StereoCounters, kStereoFields.size()>;

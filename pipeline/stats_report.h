@@ -9,7 +9,7 @@
 #include <string>
 
 #include "core/expected.h"
-#include "pipeline/latency_histogram.h"
+#include "core/latency_histogram.h"
 #include "pipeline/pipeline.h"
 
 namespace mocap::pipeline {

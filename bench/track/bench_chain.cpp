@@ -16,7 +16,8 @@
 #include <random>
 #include <vector>
 
-#include "core/latency_stats.h"
+#include "core/clock.h"
+#include "core/latency_histogram.h"
 #include "core/units.h"
 #include "kinematics/joint_angles.h"
 #include "sim/scene.h"
@@ -79,8 +80,8 @@ Case make_case(const std::array<std::vector<int>, 3>& visible, const std::array<
   return c;
 }
 
-void report_p99(benchmark::State& state, const LatencyRecorder& rec) {
-  state.counters["p99_us"] = rec.summary().p99_us;
+void report_p99(benchmark::State& state, const LatencyHistogram& rec) {
+  state.counters["p99_us"] = rec.percentile_us(0.99);
 }
 
 void BM_Baseline_AnglesFromPoses(benchmark::State& state) {
@@ -89,7 +90,7 @@ void BM_Baseline_AnglesFromPoses(benchmark::State& state) {
   kinematics::JointAngles out = solver.make_output();
   std::array<kinematics::BodyPoseView, 3> views;
   for (std::size_t b = 0; b < 3; ++b) views[b] = {true, c.poses.bodies[b].T_world_body};
-  LatencyRecorder rec(1 << 20);
+  LatencyHistogram rec;
   for (auto _ : state) {
     const std::int64_t t0 = monotonic_ns();
     solver.compute(views.data(), out);
@@ -105,7 +106,7 @@ void run_chain(benchmark::State& state, const std::array<std::vector<int>, 3>& v
   auto model = ChainModel::create(c.scene.joints_true, c.scene.targets).value();
   ChainSolver solver = ChainSolver::create(std::move(model), ChainConfig{}).value();
   ChainResult r;
-  LatencyRecorder rec(1 << 20);
+  LatencyHistogram rec;
   std::int64_t t = 1'000'000'000;
   for (auto _ : state) {
     if (warm)

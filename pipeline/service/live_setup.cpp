@@ -31,8 +31,14 @@ Expected<config::RunConfig> resolve_run_config(const std::string& path, const Cl
     if (auto r = config::check_host_port("--udp", "", *cli.udp); !r) return r.error();
     cfg.outputs.udp = {*cli.udp};
   }
-  if (cli.rate_hz) cfg.pipeline.trigger_rate_hz = *cli.rate_hz;
-  if (cli.loop_frames) cfg.sim.loop_frames = *cli.loop_frames;
+  if (cli.rate_hz) {
+    if (auto r = config::check_trigger_rate_hz("--rate", *cli.rate_hz); !r) return r.error();
+    cfg.pipeline.trigger_rate_hz = *cli.rate_hz;
+  }
+  if (cli.loop_frames) {
+    if (auto r = config::check_loop_frames("--loop-frames", *cli.loop_frames); !r) return r.error();
+    cfg.sim.loop_frames = *cli.loop_frames;
+  }
   if (cli.no_realtime) cfg.pipeline.realtime = false;
   if (cli.no_iceoryx) cfg.outputs.iceoryx = false;
   for (const auto& flag : cli.outputs) {  // a flag sets the value, keeps the options
@@ -54,7 +60,8 @@ std::vector<publish::OutputRequest> output_requests(const config::RunConfig& cfg
   std::vector<publish::OutputRequest> v;
   publish::OutputRequest udp{"udp", cfg.outputs.udp, file + ".udp", {}};
   if (!cli.multicast_if.empty()) udp.options.emplace_back("multicast_if", cli.multicast_if);
-  udp.options.emplace_back("multicast_ttl", std::to_string(cli.multicast_ttl));
+  if (cli.multicast_ttl)
+    udp.options.emplace_back("multicast_ttl", std::to_string(*cli.multicast_ttl));
   v.push_back(std::move(udp));
   v.push_back({"iceoryx", {cfg.outputs.iceoryx ? "true" : "false"}, file + ".iceoryx", {}});
   for (const config::OutputEntry& e : cfg.outputs.more)
@@ -83,8 +90,7 @@ int check_config_command(const std::string& path) {
 pipeline::PipelineOptions pipeline_options(const config::RunConfig& cfg) {
   pipeline::PipelineOptions o;
   o.trigger_rate_hz = cfg.pipeline.trigger_rate_hz;
-  o.pacing = cfg.pipeline.pacing == config::Pacing::kLockstep ? pipeline::TriggerPacing::kLockstep
-                                                              : pipeline::TriggerPacing::kPeriodic;
+  o.pacing = cfg.pipeline.pacing;
   o.realtime = cfg.pipeline.realtime;
   o.lock_memory = cfg.pipeline.lock_memory;
   o.dequeue_timeout_ms = cfg.pipeline.dequeue_timeout_ms;
@@ -107,18 +113,6 @@ pipeline::PipelineOptions pipeline_options(const config::RunConfig& cfg) {
 
 namespace {
 
-hal::TriggerMode to_hal(config::TriggerKind t) {
-  switch (t) {
-    case config::TriggerKind::kFreeRun:
-      return hal::TriggerMode::kFreeRun;
-    case config::TriggerKind::kExternal:
-      return hal::TriggerMode::kExternal;
-    case config::TriggerKind::kSoftware:
-      return hal::TriggerMode::kSoftware;
-  }
-  return hal::TriggerMode::kFreeRun;
-}
-
 // The configured settings on top of `base` (the backend's native configuration).
 hal::CameraConfig camera_config(const config::CameraSettings& s, hal::CameraConfig base,
                                 const CameraModel& rig_camera, std::uint32_t detect_ring_depth) {
@@ -129,7 +123,7 @@ hal::CameraConfig camera_config(const config::CameraSettings& s, hal::CameraConf
     if (s.exposure_us) base.exposure_us = *s.exposure_us;
     if (s.gain) base.gain = *s.gain;
   }
-  if (s.trigger) base.trigger = to_hal(*s.trigger);
+  if (s.trigger) base.trigger = *s.trigger;
   if (s.frame_rate_hz) base.frame_rate_hz = *s.frame_rate_hz;
   base.buffer_count = s.buffers ? *s.buffers : static_cast<int>(detect_ring_depth + 3);
   return base;

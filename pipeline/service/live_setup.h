@@ -26,7 +26,9 @@
 
 namespace mocap::service {
 
-// Command-line flags of `mocap run` that override the configuration file.
+// Command-line flags that override the configuration file (`mocap run`, `record`,
+// `preview`: src/app/config_flags.h). Unset: the configuration's value. No default and no
+// check of their own: resolve_run_config() checks them with the file's checks.
 struct CliOverrides {
   std::optional<std::string> udp;  // --udp HOST:PORT replaces outputs.udp
   std::optional<double> rate_hz;   // --rate
@@ -36,8 +38,8 @@ struct CliOverrides {
   // Registry outputs from flags (--ros2 -> {"ros2", "true"}, --foxglove P -> {"foxglove",
   // P}): replace or add to the configuration's outputs.NAME.
   std::vector<std::pair<std::string, std::string>> outputs;
-  std::string multicast_if;  // --multicast-if (udp option)
-  int multicast_ttl = 1;     // --multicast-ttl (udp option)
+  std::string multicast_if;          // --multicast-if (udp option; empty: unset)
+  std::optional<int> multicast_ttl;  // --multicast-ttl (udp option, checked by the registry)
 };
 
 // The configuration file (or the built-in defaults when `path` is empty) with the

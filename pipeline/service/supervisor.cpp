@@ -2,6 +2,7 @@
 #include "pipeline/service/supervisor.h"
 
 #include <cinttypes>
+#include <utility>
 
 namespace mocap::service {
 
@@ -11,7 +12,7 @@ std::int64_t seconds_to_ns(double s) { return static_cast<std::int64_t>(s * 1e9)
 
 }  // namespace
 
-Supervisor::Supervisor(const HealthSource& health, Notifier& notifier,
+Supervisor::Supervisor(const pipeline::HealthSource& health, Notifier& notifier,
                        const SupervisorOptions& options)
     : health_(health), notifier_(notifier), options_(options) {
   ping_period_ns_ = static_cast<std::int64_t>(notifier_.watchdog_usec()) * 1000 / 2;
@@ -28,25 +29,26 @@ void Supervisor::log_line(const std::string& line) {
 
 void Supervisor::poll(std::int64_t now_ns) {
   if (state_ == State::kStopping) return;
-  health_.snapshot(snap_);
-  if (snap_.frames != progress_frames_ || progress_ns_ == 0) {
-    if (stalled_ && snap_.frames != progress_frames_) {
+  snap_ = health_.health();
+  if (snap_.frames_published != progress_frames_ || progress_ns_ == 0) {
+    if (stalled_ && snap_.frames_published != progress_frames_) {
       log_line("pipeline running again after a stall of " +
                std::to_string((now_ns - progress_ns_) / 1'000'000) + " ms");
       stalled_ = false;
     }
-    progress_frames_ = snap_.frames;
+    progress_frames_ = snap_.frames_published;
     progress_ns_ = now_ns;
   }
 
   if (state_ == State::kStarting) {
-    if (snap_.frames == 0) return;
+    if (snap_.frames_published == 0) return;
     state_ = State::kRunning;
     notifier_.notify("READY=1");
     log_line("ready: the cameras deliver and frames reach the outputs");
-    ping_frames_ = snap_.frames;
+    ping_frames_ = snap_.frames_published;
     next_ping_ns_ = now_ns + ping_period_ns_;
     window_ = snap_;
+    window_latency_ = latency_now();
     window_ns_ = now_ns;
     next_status_ns_ = now_ns + status_period_ns_;
     next_log_ns_ = now_ns + log_period_ns_;
@@ -54,10 +56,10 @@ void Supervisor::poll(std::int64_t now_ns) {
     return;
   }
 
-  if (ping_period_ns_ > 0 && now_ns >= next_ping_ns_ && snap_.frames > ping_frames_) {
+  if (ping_period_ns_ > 0 && now_ns >= next_ping_ns_ && snap_.frames_published > ping_frames_) {
     notifier_.notify("WATCHDOG=1");
     ++pings_;
-    ping_frames_ = snap_.frames;
+    ping_frames_ = snap_.frames_published;
     next_ping_ns_ = now_ns + ping_period_ns_;
   }
 
@@ -79,18 +81,25 @@ void Supervisor::poll(std::int64_t now_ns) {
     }
   }
 
-  if (now_ns >= next_status_ns_) send_status(now_ns, snap_);
+  if (now_ns >= next_status_ns_) send_status(now_ns);
 }
 
-void Supervisor::send_status(std::int64_t now_ns, const HealthSnapshot& snap) {
+LatencySnapshot Supervisor::latency_now() const {
+  const LatencyHistogram* e2e = health_.end_to_end();
+  return e2e != nullptr ? e2e->snapshot() : LatencySnapshot{};
+}
+
+void Supervisor::send_status(std::int64_t now_ns) {
+  const pipeline::PipelineHealth& snap = snap_;
   const double dt_s = static_cast<double>(now_ns - window_ns_) * 1e-9;
-  const std::uint64_t frames = snap.frames - window_.frames;
+  const std::uint64_t frames = snap.frames_published - window_.frames_published;
   const double fps = dt_s > 0.0 ? static_cast<double>(frames) / dt_s : 0.0;
-  const double p99_ms = window_quantile_us(snap, window_, 0.99) / 1000.0;
+  LatencySnapshot latency = latency_now();
+  const double p99_ms = latency.since(window_latency_).stats().p99_us / 1000.0;
   char buf[160];
   std::snprintf(buf, sizeof buf, "%s%.1f fps, p99 %.2f ms, dropped %" PRIu64 " (total %" PRIu64 ")",
-                stalled_ ? "STALLED " : "", fps, p99_ms, snap.dropped - window_.dropped,
-                snap.dropped);
+                stalled_ ? "STALLED " : "", fps, p99_ms,
+                snap.frames_dropped - window_.frames_dropped, snap.frames_dropped);
   last_status_ = buf;
   notifier_.notify("STATUS=" + last_status_);
   if (log_period_ns_ > 0 && now_ns >= next_log_ns_) {
@@ -98,6 +107,7 @@ void Supervisor::send_status(std::int64_t now_ns, const HealthSnapshot& snap) {
     next_log_ns_ = now_ns + log_period_ns_;
   }
   window_ = snap;
+  window_latency_ = std::move(latency);
   window_ns_ = now_ns;
   next_status_ns_ = now_ns + status_period_ns_;
 }

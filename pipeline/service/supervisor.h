@@ -10,7 +10,8 @@
 // gone, a stage hung) therefore stops the pings even though this thread is alive, and
 // systemd's WatchdogSec= restarts the service; once frames flow again the next poll
 // pings at once. Status: every status_interval a STATUS= line with the window's frame
-// rate, trigger-to-publish p99 (health_sink.h histogram) and drops (window and total);
+// rate, trigger-to-publish p99 over the window (the pipeline's end-to-end histogram) and
+// drops (window and total), all from the one health view (pipeline/pipeline_health.h);
 // every log_interval the same line on stderr (the journal). Repeated problems (a stall)
 // are logged at once and then at most once per log_interval with a suppressed count.
 // Time is passed in (CLOCK_MONOTONIC ns), so tests drive it deterministically.
@@ -20,7 +21,8 @@
 #include <cstdio>
 #include <string>
 
-#include "pipeline/service/health_sink.h"
+#include "core/latency_histogram.h"
+#include "pipeline/pipeline_health.h"
 #include "pipeline/service/notifier.h"
 
 namespace mocap::service {
@@ -35,7 +37,8 @@ class Supervisor {
  public:
   enum class State : std::uint8_t { kStarting, kRunning, kStopping };
 
-  Supervisor(const HealthSource& health, Notifier& notifier, const SupervisorOptions& options);
+  Supervisor(const pipeline::HealthSource& health, Notifier& notifier,
+             const SupervisorOptions& options);
 
   void poll(std::int64_t now_ns);
   // STOPPING=1 (once), before the pipeline is stopped.
@@ -46,10 +49,11 @@ class Supervisor {
   const std::string& last_status() const noexcept { return last_status_; }
 
  private:
-  void send_status(std::int64_t now_ns, const HealthSnapshot& snap);
+  void send_status(std::int64_t now_ns);
+  LatencySnapshot latency_now() const;
   void log_line(const std::string& line);
 
-  const HealthSource& health_;
+  const pipeline::HealthSource& health_;
   Notifier& notifier_;
   SupervisorOptions options_;
   State state_ = State::kStarting;
@@ -57,9 +61,10 @@ class Supervisor {
   std::int64_t status_period_ns_ = 0;
   std::int64_t log_period_ns_ = 0;
 
-  HealthSnapshot snap_;         // current
-  HealthSnapshot window_;       // at the previous STATUS
-  std::int64_t window_ns_ = 0;  // time of window_
+  pipeline::PipelineHealth snap_;    // current
+  pipeline::PipelineHealth window_;  // at the previous STATUS
+  LatencySnapshot window_latency_;   // the end-to-end histogram at the previous STATUS
+  std::int64_t window_ns_ = 0;       // time of window_
   std::int64_t next_status_ns_ = 0;
   std::int64_t next_log_ns_ = 0;
   std::int64_t next_ping_ns_ = 0;

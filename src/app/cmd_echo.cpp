@@ -26,7 +26,7 @@
 #include "app/command_registry.h"
 #include "client/joints_message.h"
 #include "client/udp_receiver.h"
-#include "core/latency_stats.h"
+#include "core/clock.h"
 #include "core/units.h"
 #ifdef MOCAP_CLIENT_HAVE_ICEORYX
 #include "client/iceoryx_subscriber.h"

@@ -18,6 +18,7 @@
 #include <thread>
 
 #include "app/command_registry.h"
+#include "app/config_flags.h"
 #include "detect/blob_review.h"
 #include "formats/png_writer.h"
 #include "pipeline/pipeline.h"
@@ -37,8 +38,7 @@ extern "C" void on_preview_signal(int sig) {
 struct PreviewArgs {
   std::string config, out;
   long long frames = 1;
-  int loop_frames = 200;
-  bool loop_given = false;
+  service::CliOverrides cli;  // --loop-frames (app/config_flags.h)
 };
 
 // A JSON string literal.
@@ -96,8 +96,7 @@ int preview(const PreviewArgs& a) {
   if (a.out.empty()) return fail("mocap preview: --out: is required (the folder for the pictures)");
   if (a.frames < 1)
     return fail("mocap preview: --frames: must be >= 1, got " + std::to_string(a.frames));
-  service::CliOverrides cli;
-  if (a.loop_given) cli.loop_frames = a.loop_frames;
+  service::CliOverrides cli = a.cli;
   cli.no_realtime = true;  // a diagnostic: no SCHED_FIFO needed
   cli.no_iceoryx = true;
   auto cfg = service::resolve_run_config(a.config, cli, false);
@@ -166,13 +165,8 @@ void register_preview(CLI::App& app, int& exit_code) {
                   "The run configuration's cameras (default: the built-in simulated cameras)");
   cmd->add_option("--out", args->out, "Folder for <camera>.png and preview.json");
   cmd->add_option("--frames", args->frames, "Review the N-th image of each camera (default 1)");
-  cmd->add_option("--loop-frames", args->loop_frames,
-                  "Frames pre-rendered for the simulated cameras (default 200)")
-      ->check(CLI::Range(2, 2000));
-  cmd->callback([cmd, args, &exit_code] {
-    args->loop_given = cmd->count("--loop-frames") > 0;
-    exit_code = preview(*args);
-  });
+  add_loop_frames_flag(*cmd, args->cli);
+  cmd->callback([args, &exit_code] { exit_code = preview(*args); });
 }
 
 const CommandRegistrar kPreviewRegistrar(66, register_preview);

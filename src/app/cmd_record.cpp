@@ -19,6 +19,7 @@
 #include <thread>
 
 #include "app/command_registry.h"
+#include "app/config_flags.h"
 #include "formats/recording.h"
 #include "pipeline/pipeline.h"
 #include "pipeline/record/frame_recorder.h"
@@ -43,12 +44,10 @@ struct RecordArgs {
   std::string out;
   double duration_s = 0.0;
   long long frames = 0;
-  double rate_hz = 100.0;
-  int loop_frames = 200;
   int buffer_frames = 64;
   double progress_interval_s = 1.0;
-  bool no_realtime = false;
-  bool duration_given = false, frames_given = false, rate_given = false, loop_given = false;
+  service::CliOverrides cli;  // --rate, --loop-frames, --no-realtime (app/config_flags.h)
+  bool duration_given = false, frames_given = false;
 };
 
 Expected<void> check_args(const RecordArgs& a) {
@@ -81,10 +80,7 @@ double camera_rate_mb_s(const record::RecorderOptions& o, double rate_hz) {
 
 int record(const RecordArgs& a) {
   if (auto r = check_args(a); !r) return fail(r.error().message);
-  service::CliOverrides cli;
-  if (a.rate_given) cli.rate_hz = a.rate_hz;
-  if (a.loop_given) cli.loop_frames = a.loop_frames;
-  cli.no_realtime = a.no_realtime;
+  service::CliOverrides cli = a.cli;
   cli.no_iceoryx = true;
   auto cfg = service::resolve_run_config(a.config, cli, false);
   if (!cfg) return fail(cfg.error().message);
@@ -227,22 +223,17 @@ void register_record(CLI::App& app, int& exit_code) {
   cmd->add_option("--out", args->out, "The recording folder to write (new or empty)");
   cmd->add_option("--duration", args->duration_s, "Stop after this many seconds");
   cmd->add_option("--frames", args->frames, "Stop after this many frames");
-  cmd->add_option("--rate", args->rate_hz, "Trigger rate in Hz (default: the configuration's)")
-      ->check(CLI::Range(1.0, 1000.0));
-  cmd->add_option("--loop-frames", args->loop_frames,
-                  "Frames pre-rendered for the simulated cameras (default 200)")
-      ->check(CLI::Range(2, 2000));
+  add_rate_flag(*cmd, args->cli);
+  add_loop_frames_flag(*cmd, args->cli);
   cmd->add_option("--buffer-frames", args->buffer_frames,
                   "Frames per camera the writer may fall behind before images are dropped "
                   "(power of two, default 64)");
   cmd->add_option("--progress-interval", args->progress_interval_s,
                   "Seconds between progress lines on stderr (default 1; 0: off)");
-  cmd->add_flag("--no-realtime", args->no_realtime, "No CPU pinning and no SCHED_FIFO");
+  add_no_realtime_flag(*cmd, args->cli);
   cmd->callback([cmd, args, &exit_code] {
     args->duration_given = cmd->count("--duration") > 0;
     args->frames_given = cmd->count("--frames") > 0;
-    args->rate_given = cmd->count("--rate") > 0;
-    args->loop_given = cmd->count("--loop-frames") > 0;
     exit_code = record(*args);
   });
 }

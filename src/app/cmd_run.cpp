@@ -28,10 +28,10 @@
 #include <vector>
 
 #include "app/command_registry.h"
+#include "app/config_flags.h"
 #include "hal/camera.h"
 #include "pipeline/pipeline.h"
 #include "pipeline/publish/output_registry.h"
-#include "pipeline/service/health_sink.h"
 #include "pipeline/service/live_setup.h"
 #include "pipeline/service/notifier.h"
 #include "pipeline/service/supervisor.h"
@@ -71,36 +71,17 @@ bool is_roudi(int pid) {
 constexpr int kExitRouDiShutdown = 75;
 
 struct RunArgs {
-  std::string udp = "127.0.0.1:7755";
-  std::string multicast_if;  // --udp to a multicast group: local interface to send from
-  int multicast_ttl = 1;
+  // The configuration's overrides (--udp, --multicast-*, --rate, --loop-frames,
+  // --no-realtime, --no-iceoryx): no defaults here, checked by resolve_run_config.
+  service::CliOverrides cli;
   double duration_s = 0.0;  // 0: until SIGINT/SIGTERM
   std::string stats;
   double stats_interval_s = 5.0;  // 0: no periodic report
-  double rate_hz = 100.0;
-  int loop_frames = 200;
-  bool no_realtime = false;
-  bool no_iceoryx = false;
-  bool ros2 = false;         // --ros2
-  std::string foxglove;      // --foxglove [ADDR:]PORT
-  std::string config;        // --config FILE
-  std::string check_config;  // --check-config FILE
-  bool udp_given = false, rate_given = false, loop_frames_given = false;
+  bool ros2 = false;              // --ros2
+  std::string foxglove;           // --foxglove [ADDR:]PORT
+  std::string config;             // --config FILE
+  std::string check_config;       // --check-config FILE
 };
-
-// "HOST:PORT" with a port in 1..65535 (the UDP publisher resolves the host).
-Expected<std::pair<std::string, int>> parse_host_port(const std::string& s) {
-  const std::size_t colon = s.rfind(':');
-  if (colon == std::string::npos || colon == 0 || colon + 1 == s.size())
-    return make_error("--udp", s, "expected HOST:PORT");
-  int port = 0;
-  for (std::size_t i = colon + 1; i < s.size(); ++i) {
-    if (s[i] < '0' || s[i] > '9' || port > 65535) return make_error("--udp", s, "bad port");
-    port = port * 10 + (s[i] - '0');
-  }
-  if (port < 1 || port > 65535) return make_error("--udp", s, "port must be in 1..65535");
-  return std::make_pair(s.substr(0, colon), port);
-}
 
 void install_stop_handlers() {
   struct sigaction sa {};
@@ -118,14 +99,18 @@ void supervise(const pipeline::Pipeline& pipe, const RunArgs& a, service::Superv
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
   };
   auto last_report = t0;
-  pipeline::LatencySnapshot last_e2e = pipe.end_to_end()->snapshot();
+  LatencySnapshot last_e2e = pipe.end_to_end()->snapshot();
   while (!g_stop_requested.load(std::memory_order_relaxed)) {
     if (a.duration_s > 0.0 && seconds_since(t0) >= a.duration_s) break;
+    if (pipe.finished()) {  // a replayed recording was played to its end
+      std::fprintf(stderr, "mocap run: the recording ended\n");
+      break;
+    }
     service.poll(hal::monotonic_ns());  // sd_notify READY / WATCHDOG / STATUS
     if (a.stats_interval_s > 0.0 && seconds_since(last_report) >= a.stats_interval_s) {
       const double interval_s = seconds_since(last_report);
       last_report = std::chrono::steady_clock::now();
-      pipeline::LatencySnapshot e2e = pipe.end_to_end()->snapshot();
+      LatencySnapshot e2e = pipe.end_to_end()->snapshot();
       const std::string line = pipeline::format_progress_line(
           seconds_since(t0), interval_s, e2e.since(last_e2e).stats(), pipe.health());
       std::fprintf(stderr, "mocap run: %s\n", line.c_str());
@@ -154,21 +139,12 @@ void report_camera_faults(const pipeline::PipelineHealth& h) {
 }
 
 int run_live(const RunArgs& a) {
-  auto udp = parse_host_port(a.udp);
-  if (!udp) return fail(udp.error().message);
   if (a.duration_s < 0.0) return fail("--duration: must be >= 0");
   if (a.stats_interval_s < 0.0) return fail("--stats-interval: must be >= 0");
 
   // The configuration (--config FILE, else the built-in sim defaults) with the flags given
   // on top; cameras, tracker and stage table from it (pipeline/service/live_setup.h).
-  service::CliOverrides cli;
-  if (a.udp_given) cli.udp = a.udp;
-  if (a.rate_given) cli.rate_hz = a.rate_hz;
-  if (a.loop_frames_given) cli.loop_frames = a.loop_frames;
-  cli.no_realtime = a.no_realtime;
-  cli.no_iceoryx = a.no_iceoryx;
-  cli.multicast_if = a.multicast_if;
-  cli.multicast_ttl = a.multicast_ttl;
+  service::CliOverrides cli = a.cli;
   if (a.ros2) cli.outputs.emplace_back("ros2", "true");
   if (!a.foxglove.empty()) cli.outputs.emplace_back("foxglove", a.foxglove);
   auto cfg = service::resolve_run_config(a.config, cli);
@@ -191,12 +167,8 @@ int run_live(const RunArgs& a) {
   if (!outputs) return fail(outputs.error().message);
   for (const std::string& n : outputs->notices)
     std::fprintf(stderr, "mocap run: note: %s\n", n.c_str());
-  // The service's view of the pipeline's health: one more sink at the end of the pipeline.
-  service::HealthSink health;
-  std::vector<publish::OutputSink*> sink_list = outputs->list();
-  sink_list.push_back(&health);
-
-  auto pipe = pipeline::Pipeline::create(std::move(processor), (*live)->cameras(), sink_list, opt);
+  auto pipe =
+      pipeline::Pipeline::create(std::move(processor), (*live)->cameras(), outputs->list(), opt);
   if (!pipe) return fail(pipe.error().message);
 
   if (g_stop_requested.load(std::memory_order_relaxed)) {
@@ -216,7 +188,7 @@ int run_live(const RunArgs& a) {
   service::SupervisorOptions so;
   so.status_interval_s = cfg->service.status_interval_s;
   so.log_interval_s = cfg->service.log_interval_s;
-  service::Supervisor service(health, notifier, so);
+  service::Supervisor service(**pipe, notifier, so);  // the pipeline's one health view
   supervise(**pipe, a, service);
   service.stopping();
   (*pipe)->stop();
@@ -244,26 +216,23 @@ void register_run(CLI::App& app, int& exit_code) {
   auto args = std::make_shared<RunArgs>();
   CLI::App* cmd = app.add_subcommand(
       "run", "Run the live tracker (default: simulated cameras of the built-in scenario)");
-  cmd->add_option("--udp", args->udp, "Send joint angles to HOST:PORT (default 127.0.0.1:7755)");
-  cmd->add_option("--multicast-if", args->multicast_if,
+  cmd->add_option("--udp", args->cli.udp,
+                  "Send joint angles to HOST:PORT (default: the configuration's; built in: "
+                  "127.0.0.1:7755)");
+  cmd->add_option("--multicast-if", args->cli.multicast_if,
                   "With --udp to a multicast group: local interface address to send from");
-  cmd->add_option("--multicast-ttl", args->multicast_ttl,
-                  "With --udp to a multicast group: hops (default 1: the local network)")
-      ->check(CLI::Range(0, 255));
+  cmd->add_option("--multicast-ttl", args->cli.multicast_ttl,
+                  "With --udp to a multicast group: hops (default 1: the local network)");
   cmd->add_option("--duration", args->duration_s,
                   "Stop after this many seconds (default: until Ctrl-C)");
   cmd->add_option("--stats", args->stats, "Write latency statistics to this JSON file at the end");
   cmd->add_option("--stats-interval", args->stats_interval_s,
                   "Print a progress line (fps, latency, drops) to stderr every S seconds "
                   "(default 5; 0: off)");
-  cmd->add_option("--rate", args->rate_hz,
-                  "Trigger rate of the simulated cameras in Hz (default 100)")
-      ->check(CLI::Range(1.0, 1000.0));
-  cmd->add_option("--loop-frames", args->loop_frames,
-                  "Frames pre-rendered for the simulated cameras (default 200: 320 MB)")
-      ->check(CLI::Range(2, 2000));
-  cmd->add_flag("--no-realtime", args->no_realtime, "No CPU pinning and no SCHED_FIFO");
-  cmd->add_flag("--no-iceoryx", args->no_iceoryx, "Do not publish over iceoryx shared memory");
+  add_rate_flag(*cmd, args->cli);
+  add_loop_frames_flag(*cmd, args->cli);
+  add_no_realtime_flag(*cmd, args->cli);
+  cmd->add_flag("--no-iceoryx", args->cli.no_iceoryx, "Do not publish over iceoryx shared memory");
   cmd->add_flag(
       "--ros2", args->ros2,
       "Publish /joint_states and /tf over DDS as ROS 2 does (ROS_DOMAIN_ID; docs/ros2.md)");
@@ -275,14 +244,11 @@ void register_run(CLI::App& app, int& exit_code) {
                   "docs/operations.md); flags given here override it");
   cmd->add_option("--check-config", args->check_config,
                   "Only validate the configuration FILE: exit 0, or 1 with a one-line error");
-  cmd->callback([cmd, args, &exit_code] {
+  cmd->callback([args, &exit_code] {
     if (!args->check_config.empty()) {
       exit_code = service::check_config_command(args->check_config);
       return;
     }
-    args->udp_given = cmd->count("--udp") > 0;
-    args->rate_given = cmd->count("--rate") > 0;
-    args->loop_frames_given = cmd->count("--loop-frames") > 0;
     exit_code = run_live(*args);
   });
 }

@@ -8,6 +8,7 @@
 
 #include <unistd.h>
 
+#include <cstdio>
 #include <filesystem>
 
 #include "config/config_reader.h"
@@ -37,13 +38,13 @@ const char* to_string(CameraBackend b) noexcept {
   return "?";
 }
 
-const char* to_string(TriggerKind t) noexcept {
+const char* to_string(TriggerMode t) noexcept {
   switch (t) {
-    case TriggerKind::kFreeRun:
+    case TriggerMode::kFreeRun:
       return "free_run";
-    case TriggerKind::kExternal:
+    case TriggerMode::kExternal:
       return "external";
-    case TriggerKind::kSoftware:
+    case TriggerMode::kSoftware:
       return "software";
   }
   return "?";
@@ -68,6 +69,25 @@ std::string host_port_problem(const std::string& value) {
 }
 
 }  // namespace
+
+Expected<void> check_trigger_rate_hz(const std::string& where, double hz) {
+  if (!(hz >= kMinTriggerRateHz && hz <= kMaxTriggerRateHz)) {
+    char buf[96];
+    std::snprintf(buf, sizeof buf, "must be in [%g, %g] Hz, got %g", kMinTriggerRateHz,
+                  kMaxTriggerRateHz, hz);
+    return make_error(where, "", buf);
+  }
+  return {};
+}
+
+Expected<void> check_loop_frames(const std::string& where, long long frames) {
+  if (frames < kMinLoopFrames || frames > kMaxLoopFrames) {
+    return make_error(where, "",
+                      "must be in " + std::to_string(kMinLoopFrames) + ".." +
+                          std::to_string(kMaxLoopFrames) + ", got " + std::to_string(frames));
+  }
+  return {};
+}
 
 Expected<void> check_host_port(const std::string& file, const std::string& where,
                                const std::string& value) {
@@ -137,9 +157,9 @@ void read_camera(const YAML::Node& node, const std::string& where, const std::st
   if (const auto v = s.integer("exposure_us", 1, 10'000'000))
     cam.exposure_us = static_cast<int>(*v);
   if (const auto v = s.number("gain", 0.0, 1e6)) cam.gain = *v;
-  cam.trigger = s.choice<TriggerKind>("trigger", {{"free_run", TriggerKind::kFreeRun},
-                                                  {"external", TriggerKind::kExternal},
-                                                  {"software", TriggerKind::kSoftware}});
+  cam.trigger = s.choice<TriggerMode>("trigger", {{"free_run", TriggerMode::kFreeRun},
+                                                  {"external", TriggerMode::kExternal},
+                                                  {"software", TriggerMode::kSoftware}});
   cam.frame_rate_hz = positive(s, "frame_rate_hz", 10000.0);
   if (const auto v = s.integer("buffers", 2, 64)) cam.buffers = static_cast<int>(*v);
 }
@@ -183,9 +203,9 @@ void read_pipeline(const YAML::Node& node, PipelineSettings& p) {
   const Section s(
       node, "pipeline",
       {"trigger_rate_hz", "pacing", "realtime", "lock_memory", "dequeue_timeout_ms", "stages"});
-  set(p.trigger_rate_hz, positive(s, "trigger_rate_hz", 10000.0));
-  set(p.pacing, s.choice<Pacing>(
-                    "pacing", {{"periodic", Pacing::kPeriodic}, {"lockstep", Pacing::kLockstep}}));
+  set(p.trigger_rate_hz, s.number("trigger_rate_hz", kMinTriggerRateHz, kMaxTriggerRateHz));
+  set(p.pacing, s.choice<TriggerPacing>("pacing", {{"periodic", TriggerPacing::kPeriodic},
+                                                   {"lockstep", TriggerPacing::kLockstep}}));
   set(p.realtime, s.flag("realtime"));
   set(p.lock_memory, s.flag("lock_memory"));
   set(p.dequeue_timeout_ms, s.integer("dequeue_timeout_ms", 1, 1000));
@@ -373,7 +393,7 @@ Expected<RunConfig> parse(const std::string& path, const YAML::Node& root) {
   read_stereo(top.node("stereo"), cfg.tracker.stereo);
   read_identification(top.node("identification"), cfg.tracker.identify);
   const Section sim(top.node("sim"), "sim", {"loop_frames", "scene", "cameras", "rig"});
-  set(cfg.sim.loop_frames, sim.integer("loop_frames", 2, 2000));
+  set(cfg.sim.loop_frames, sim.integer("loop_frames", kMinLoopFrames, kMaxLoopFrames));
   set(cfg.sim.scene,
       sim.choice<mocap::sim::SceneKind>("scene", {{"limbs", mocap::sim::SceneKind::kLimbs},
                                                   {"stalks", mocap::sim::SceneKind::kStalks}}));

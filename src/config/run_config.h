@@ -5,7 +5,8 @@
 // Relative paths are resolved against the directory of the configuration file.
 //
 // This module is plain data: it is built before hal/ and pipeline/, so camera settings
-// and the stage table are described here with their own small enums, and the service
+// and the stage table are described here (the trigger mode and pacing enums are the
+// shared ones of core/capture_modes.h), and the service
 // layer (pipeline/service/live_setup.h) maps them onto hal::CameraConfig and
 // pipeline::StageSpec. Settings left out of the file are std::nullopt / defaults and
 // keep the backend's native value or the pipeline's default table.
@@ -18,6 +19,7 @@
 #include <vector>
 
 #include "core/camera_set.h"
+#include "core/capture_modes.h"
 #include "core/expected.h"
 #include "core/image.h"
 #include "sim/scene_layouts.h"
@@ -26,11 +28,9 @@
 namespace mocap::config {
 
 enum class CameraBackend : std::uint8_t { kSim, kReplay, kV4l2, kLibcamera };
-enum class TriggerKind : std::uint8_t { kFreeRun, kExternal, kSoftware };
-enum class Pacing : std::uint8_t { kPeriodic, kLockstep };
 
 const char* to_string(CameraBackend b) noexcept;
-const char* to_string(TriggerKind t) noexcept;
+const char* to_string(TriggerMode t) noexcept;
 
 struct CameraSettings {
   CameraBackend backend = CameraBackend::kSim;
@@ -42,7 +42,7 @@ struct CameraSettings {
   int height = 0;
   std::optional<int> exposure_us;
   std::optional<double> gain;
-  std::optional<TriggerKind> trigger;
+  std::optional<TriggerMode> trigger;
   std::optional<double> frame_rate_hz;  // free-run rate
   std::optional<int> buffers;           // driver buffers; default: ring depth + 3
 };
@@ -62,7 +62,7 @@ struct StageSettings {                      // unset: the default table's value
 
 struct PipelineSettings {
   double trigger_rate_hz = 100.0;
-  Pacing pacing = Pacing::kPeriodic;
+  TriggerPacing pacing = TriggerPacing::kPeriodic;
   bool realtime = true;     // CPU pinning + SCHED_FIFO (falls back when not permitted)
   bool lock_memory = true;  // mlockall (falls back when not permitted)
   int dequeue_timeout_ms = 20;
@@ -128,6 +128,15 @@ struct RunConfig {
   ServiceSettings service;
   FaultSettings faults;
 };
+
+// The ranges of the settings a command-line flag may also set, and their one check:
+// the file's keys (pipeline.trigger_rate_hz, sim.loop_frames) and the flags (--rate,
+// --loop-frames) are validated by these, so both accept exactly the same values.
+inline constexpr int kMinLoopFrames = 2;
+inline constexpr int kMaxLoopFrames = 2000;
+// `where` names the key or flag in the error ("--rate: must be in [0.01, 10000] Hz, got 0").
+Expected<void> check_trigger_rate_hz(const std::string& where, double hz);
+Expected<void> check_loop_frames(const std::string& where, long long frames);
 
 // The configuration `mocap run` uses without a file: the simulated stereo pair of the
 // built-in scenario, UDP to 127.0.0.1:7755 and iceoryx.

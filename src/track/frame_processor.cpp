@@ -4,7 +4,7 @@
 #include <algorithm>
 #include <utility>
 
-#include "core/latency_stats.h"
+#include "core/clock.h"
 
 namespace mocap {
 

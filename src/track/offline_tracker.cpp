@@ -63,7 +63,7 @@ Expected<OfflineTrackResult> track_recording(const OfflineTrackOptions& opt) {
 
   const auto& frames = rec->frames();
   OfflineTrackResult result;
-  result.stats = std::make_unique<TrackStats>(frames.size());
+  result.stats = std::make_unique<TrackStats>();
   for (const MarkerTarget& t : targets->bodies) result.body_names.push_back(t.name);
   result.body_found.assign(targets->bodies.size(), 0);
   if (model) {
@@ -199,7 +199,7 @@ std::string format_track_summary(const OfflineTrackResult& r) {
     }
   }
   if (r.stats) {
-    const std::pair<const char*, const LatencyRecorder*> stages[] = {
+    const std::pair<const char*, const LatencyHistogram*> stages[] = {
         {"detect", &r.stats->detect},
         {"triangulate", &r.stats->triangulate},
         {"identify", &r.stats->identify},
@@ -207,7 +207,7 @@ std::string format_track_summary(const OfflineTrackResult& r) {
         {"frame", &r.stats->frame}};
     s += "  latency per frame (us):       p50        p99        max\n";
     for (const auto& [name, rec] : stages) {
-      const LatencySummary l = rec->summary();
+      const LatencyStats l = rec->stats();
       std::snprintf(buf, sizeof buf, "    %-12s %14.1f %10.1f %10.1f\n", name, l.p50_us, l.p99_us,
                     l.max_us);
       s += buf;

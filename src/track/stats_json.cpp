@@ -71,7 +71,7 @@ std::string stats_to_json(const TrackStats& stats) {
   std::snprintf(buf, sizeof buf, "{\"frames\": %lld,\n \"stages\": {",
                 static_cast<long long>(stats.frames));
   out += buf;
-  const std::pair<const char*, const LatencyRecorder*> stages[] = {
+  const std::pair<const char*, const LatencyHistogram*> stages[] = {
       {"detect", &stats.detect},
       {"triangulate", &stats.triangulate},
       {"identify", &stats.identify},
@@ -79,7 +79,7 @@ std::string stats_to_json(const TrackStats& stats) {
       {"frame", &stats.frame}};
   bool first = true;
   for (const auto& [name, rec] : stages) {
-    const LatencySummary s = rec->summary();
+    const LatencyStats s = rec->stats();
     std::snprintf(
         buf, sizeof buf,
         "%s\n   \"%s\": {\"p50_us\": %.3f, \"p99_us\": %.3f, \"max_us\": %.3f, \"mean_us\": %.3f}",

@@ -9,15 +9,14 @@
 #include <vector>
 
 #include "core/expected.h"
-#include "core/latency_stats.h"
+#include "core/latency_histogram.h"
 #include "track/frame_processor.h"
 
 namespace mocap {
 
+// The stages' times in the one latency histogram (core/latency_histogram.h: percentiles
+// at most 1/64 above the exact nearest-rank value, fixed memory whatever the length).
 struct TrackStats {
-  explicit TrackStats(std::size_t capacity)
-      : detect(capacity), triangulate(capacity), identify(capacity), angles(capacity), frame(capacity) {}
-
   void record(const StageTimesNs& t) noexcept {
     detect.record(t.detect);
     triangulate.record(t.triangulate);
@@ -27,7 +26,7 @@ struct TrackStats {
   }
 
   std::int64_t frames = 0;
-  LatencyRecorder detect, triangulate, identify, angles, frame;
+  LatencyHistogram detect, triangulate, identify, angles, frame;
   std::vector<std::pair<std::string, std::uint64_t>> counters;  // filled at the end
 };
 

@@ -36,8 +36,8 @@ TEST(RunConfig, ShippedExampleLoads) {
   auto cfg = load_run_config(test::source_dir() + "/deploy/mocap.yaml");
   ASSERT_TRUE(cfg) << cfg.error().message;
   EXPECT_EQ(cfg->cameras[0].backend, CameraBackend::kSim);
-  EXPECT_EQ(cfg->cameras[0].trigger, TriggerKind::kSoftware);
-  EXPECT_EQ(cfg->cameras[1].trigger, TriggerKind::kExternal);
+  EXPECT_EQ(cfg->cameras[0].trigger, TriggerMode::kSoftware);
+  EXPECT_EQ(cfg->cameras[1].trigger, TriggerMode::kExternal);
   EXPECT_DOUBLE_EQ(cfg->pipeline.trigger_rate_hz, 100.0);
   ASSERT_TRUE(cfg->pipeline.stages[2].cpu.has_value());  // identify
   EXPECT_EQ(*cfg->pipeline.stages[2].cpu, 1);
@@ -87,7 +87,7 @@ TEST(RunConfig, ThresholdsAndOutputsAreRead) {
   EXPECT_DOUBLE_EQ(cfg->tracker.stereo.max_depth_mm, 5000.0);
   EXPECT_EQ(cfg->tracker.identify.min_markers, 4);
   EXPECT_FALSE(cfg->tracker.identify.temporal);
-  EXPECT_EQ(cfg->pipeline.pacing, Pacing::kLockstep);
+  EXPECT_EQ(cfg->pipeline.pacing, TriggerPacing::kLockstep);
   EXPECT_FALSE(cfg->pipeline.realtime);
   EXPECT_EQ(*cfg->pipeline.stages[3].cpu, -1);
   EXPECT_EQ(cfg->faults.stall_after_frames, 50u);

@@ -1,7 +1,8 @@
 // The live pipeline on the replay camera gives the same body poses and joint angles as
 // the offline tracker (`mocap track`, track_recording) on the same simulated recording:
 // both run the same FrameProcessor stages, the pipeline split over its threads. Lockstep
-// triggering makes the live run lossless, so temporal state evolves identically.
+// triggering makes the live run lossless, so temporal state evolves identically. The
+// recording's end stops the triggering and finishes the run (no frame limit given).
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -115,7 +116,7 @@ TEST(PipelineReplay, SamePosesAsOfflineTracking) {
   test::RecordingSink sink(100);
   PipelineOptions opt = test::test_options();
   opt.pacing = TriggerPacing::kLockstep;
-  opt.max_frames = 25;
+  opt.max_frames = 0;  // no limit: the recording's end ends the triggering (finished())
   opt.observer = &observer;
   auto p = Pipeline::create(std::move(proc).value(), {cams[0].get(), cams[1].get()}, {&sink}, opt);
   ASSERT_TRUE(p.ok());

@@ -28,7 +28,7 @@ TEST(LiveSetup, StageOverridesOnTopOfTheDefaultTable) {
   cfg.pipeline.stages[2].ring_depth = 8;
   cfg.pipeline.stages[3].priority = 0;           // publish
   cfg.pipeline.detect_camera[1].ring_depth = 6;  // detect1 only
-  cfg.pipeline.pacing = config::Pacing::kLockstep;
+  cfg.pipeline.pacing = TriggerPacing::kLockstep;
   cfg.pipeline.trigger_rate_hz = 250.0;
   const pipeline::PipelineOptions o = pipeline_options(cfg);
   using pipeline::StageKind;

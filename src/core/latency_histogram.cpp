@@ -1,10 +1,10 @@
 // Design: see latency_histogram.h. Report-time code: walks the 2304 buckets.
-#include "pipeline/latency_histogram.h"
+#include "core/latency_histogram.h"
 
 #include <algorithm>
 #include <cmath>
 
-namespace mocap::pipeline {
+namespace mocap {
 namespace {
 
 // Nearest rank: the smallest value with at least ceil(q * count) samples at or below it.
@@ -83,4 +83,4 @@ LatencyStats LatencySnapshot::stats() const {
   return s;
 }
 
-}  // namespace mocap::pipeline
+}  // namespace mocap

@@ -11,9 +11,9 @@
 #include <thread>
 #include <vector>
 
-#include "pipeline/latency_histogram.h"
+#include "core/latency_histogram.h"
 
-namespace mocap::pipeline {
+namespace mocap {
 namespace {
 
 using H = LatencyHistogram;
@@ -107,4 +107,4 @@ TEST(LatencyHistogram, ReaderWhileWriterRecords) {
 }
 
 }  // namespace
-}  // namespace mocap::pipeline
+}  // namespace mocap

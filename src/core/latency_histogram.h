@@ -19,7 +19,7 @@
 #include <cstdint>
 #include <vector>
 
-namespace mocap::pipeline {
+namespace mocap {
 
 // A summary in microseconds (p999_us is the 99.9th percentile).
 struct LatencyStats {
@@ -100,4 +100,4 @@ class LatencyHistogram {
   std::atomic<std::int64_t> max_ns_{0};
 };
 
-}  // namespace mocap::pipeline
+}  // namespace mocap

@@ -1,0 +1,99 @@
+// Design: the capture stage (one thread, the highest priority of the stage table). It
+// drives the rig's cameras: fires the software triggers on their grid (absolute
+// deadlines; lockstep pacing waits for the previous frame to be retired), dequeues every
+// camera without ever waiting on a stalled one past the next trigger, counts each
+// camera's clock steps (timestamp_check.h; the frame goes on unchanged), offers each
+// frame to the FrameTap (`mocap record`), hands it to its camera's detect stage (dropped
+// when the detector holds every slot: capture_dropped_cam#) and releases the buffers the
+// detect stages give back. It alone calls the cameras' release(), so every camera buffer
+// has one owner thread. A camera's end of stream (a replayed recording's last frame was
+// delivered) ends the triggering, as max_frames does. It owns no ring: each detect stage owns its
+// input and return rings; the capture holds their producer and consumer ends. run() is the hot
+// path: noexcept, allocation-free, lock-free, no logging; the only syscalls are the cameras'
+// trigger/dequeue/release and the trigger clock's sleep.
+#pragma once
+
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <vector>
+
+#include "hal/camera.h"
+#include "pipeline/detect_stage.h"
+#include "pipeline/stage_context.h"
+#include "pipeline/timestamp_check.h"
+#include "rt/counter_group.h"
+
+namespace mocap::pipeline {
+
+class CaptureStage {
+ public:
+  // cameras (2..kMaxCameras) and detect stages (one per camera, same order) outlive it.
+  CaptureStage(StageContext& context, const std::vector<hal::Camera*>& cameras,
+               const std::vector<DetectStage*>& detect, std::int64_t start_ns);
+
+  void run() noexcept;  // the thread's body, until the context stops
+  // After every thread was joined: every camera buffer still in a ring back to its camera.
+  void drain() noexcept;
+
+  // Any thread.
+  std::uint64_t triggered() const noexcept { return counters_.triggered.get(); }
+  // Once the triggering is done (StageContext::triggering_done()): the highest sequence
+  // the cameras delivered + 1, the sequence the pipeline must retire to be finished
+  // (sequences are the cameras' own: a replay's start at its recording's first frame).
+  std::uint64_t end_sequence() const noexcept {
+    // relaxed: read after StageContext::triggering_done() (acquire), which it precedes.
+    return end_sequence_.load(std::memory_order_relaxed);
+  }
+  // Time since camera c's last frame (since the start before its first one).
+  std::int64_t camera_silent_ns(int camera, std::int64_t now_ns) const noexcept {
+    // relaxed: a single writer (this stage); readers only want a recent, untorn time.
+    const std::int64_t last =
+        last_frame_ns_[static_cast<std::size_t>(camera)].load(std::memory_order_relaxed);
+    return now_ns - (last != 0 ? last : start_ns_);
+  }
+  // Camera c's clock steps (backwards + jumps).
+  std::uint64_t timestamp_steps(int camera) const noexcept {
+    const auto c = static_cast<std::size_t>(camera);
+    return counters_.timestamp_backwards[c].get() + counters_.timestamp_jumps[c].get();
+  }
+  void report(rt::CounterReport& out) const;  // report time
+
+ private:
+  void release_returned() noexcept;
+  // trigger_ns: host time of the last software trigger (0: free-running cameras).
+  void on_frame_received(int camera, const hal::Frame& frame, std::int64_t trigger_ns) noexcept;
+  void setup_clock_checks(bool triggered_mode, std::int64_t period_ns) noexcept;
+  // Lockstep: waits (bounded) until `sequence` was retired.
+  void wait_retired(std::uint64_t sequence) noexcept;
+
+  static constexpr std::int64_t kLockstepTimeoutNs = 1'000'000'000;
+
+  StageContext& context_;
+  const std::vector<hal::Camera*> cameras_;
+  const std::vector<DetectStage*> detect_;
+  const int camera_count_;
+  const std::int64_t start_ns_;
+  std::array<TimestampCheck, kMaxCameras> clock_checks_{};  // this thread (set in run())
+  std::array<std::atomic<std::int64_t>, kMaxCameras> last_frame_ns_{};  // this thread writes
+  void finish_triggering() noexcept;
+  std::uint64_t delivered_end_ = 0;             // highest sequence dequeued + 1 (this thread)
+  std::atomic<std::uint64_t> end_sequence_{0};  // delivered_end_ when the triggering ended
+
+  struct alignas(64) Counters {
+    rt::CounterGroup group;
+    rt::NamedCounter triggered{group, "triggered"};
+    rt::NamedCounter trigger_errors{group, "trigger_errors"};
+    rt::NamedCounter trigger_overruns{group, "trigger_overruns"};        // periods skipped (late)
+    rt::NamedCounter trigger_late_max_us{group, "trigger_late_max_us"};  // vs its deadline
+    rt::CameraCounters dequeue_timeouts{group, "dequeue_timeouts_cam#"};
+    rt::CameraCounters max_silence_us{group, "camera_max_silence_us_cam#"};  // between frames
+    rt::NamedCounter dequeue_errors{group, "dequeue_errors"};
+    rt::NamedCounter release_errors{group, "release_errors"};
+    rt::CameraCounters ring_full{group, "capture_dropped_cam#"};  // detector held every slot
+    rt::CameraCounters timestamp_backwards{group, "timestamp_backwards_cam#"};
+    rt::CameraCounters timestamp_jumps{group, "timestamp_jumps_cam#"};
+  } counters_;
+};
+
+}  // namespace mocap::pipeline

@@ -1,0 +1,95 @@
+// Design: see detect_stage.h.
+#include "pipeline/detect_stage.h"
+
+#include <string>
+
+namespace mocap::pipeline {
+
+Expected<std::unique_ptr<DetectStage>> DetectStage::create(int camera, const hal::Camera& cam,
+                                                           std::uint32_t input_depth,
+                                                           StageContext& context,
+                                                           FrameProcessor& processor,
+                                                           rt::SlotPool<BlobSlot>& out) {
+  if (camera < 0 || camera >= kMaxCameras)
+    return make_error("pipeline", "camera", "index " + std::to_string(camera) + " out of range");
+  // Camera buffers: the input ring, one in the detector's hand, one on its way back.
+  const int camera_buffers = cam.config().buffer_count;
+  if (camera_buffers < static_cast<int>(input_depth) + 2) {
+    return make_error(cam.name(), "buffer_count",
+                      std::to_string(camera_buffers) +
+                          " buffers; the pipeline needs detect ring_depth + 2 = " +
+                          std::to_string(input_depth + 2));
+  }
+  const auto input = static_cast<std::uint32_t>(rt::next_power_of_two_at_least(input_depth));
+  const auto back = static_cast<std::uint32_t>(
+      rt::next_power_of_two_at_least(static_cast<std::size_t>(camera_buffers)));
+  return std::unique_ptr<DetectStage>(
+      new DetectStage(camera, input, back, context, processor, out));
+}
+
+DetectStage::DetectStage(int camera, std::uint32_t input_capacity, std::uint32_t return_capacity,
+                         StageContext& context, FrameProcessor& processor,
+                         rt::SlotPool<BlobSlot>& out)
+    : camera_(camera),
+      context_(context),
+      processor_(processor),
+      out_(out),
+      input_(input_capacity),
+      returned_(return_capacity),
+      counters_(camera) {}
+
+void DetectStage::run() noexcept {
+  const StageId id = StageId::detect(camera_);
+  context_.loop_start(id);
+  Doorbell& bell = context_.bell(id);
+  Doorbell& next = context_.bell(StageId::kIdentify);
+  while (!context_.stopping()) {
+    const std::uint32_t seen = bell.snapshot();
+    hal::Frame f;
+    if (!input_.try_pop(f)) {
+      bell.wait(seen, kIdleWaitNs);
+      continue;
+    }
+    hal::Frame newer;
+    while (input_.try_pop(newer)) {  // drop-oldest: work on the freshest frame
+      returned_.try_push(f);         // cannot fail: holds every camera buffer
+      counters_.skipped.add();
+      f = newer;
+    }
+    rt::SlotHandle h;
+    if (!out_.acquire(h)) {  // identify holds every slot (stalled): drop
+      counters_.no_slot.add();
+      returned_.try_push(f);
+      continue;
+    }
+    const std::int64_t t0 = monotonic_ns();
+    BlobSlot& slot = out_[h];
+    slot.blobs.clear();
+    slot.present = !f.missing && !f.image.empty();
+    if (slot.present) {
+      processor_.detect_camera(camera_, f.image, slot.blobs);
+      library_.blobs.add(slot.blobs.size());
+      library_.detector.publish(kDetectorFields, processor_.detector_counters(camera_));
+    }
+    slot.sequence = f.sequence;
+    slot.capture_ns = f.timestamp_ns;
+    const std::int64_t capture_ns = f.timestamp_ns;  // the slot is identify's once published
+    returned_.try_push(f);                           // the image is no longer needed
+    out_.publish(h);
+    next.ring();
+    const std::int64_t t1 = monotonic_ns();
+    work_.record(t1 - t0);
+    latency_.record(t1 - capture_ns);
+  }
+  context_.loop_end(id);
+}
+
+void DetectStage::report(rt::CounterReport& out) const {
+  counters_.group.report(0, out);
+  const std::string prefix = rt::counter_name("detect_cam#_", camera_);
+  out.emplace_back(prefix + "blobs", library_.blobs.get());
+  for (std::size_t i = 0; i < kDetectorFields.size(); ++i)
+    out.emplace_back(prefix + kDetectorFields[i].name, library_.detector.get(i));
+}
+
+}  // namespace mocap::pipeline

@@ -1,0 +1,173 @@
+// Design: see identify_stage.h.
+#include "pipeline/identify_stage.h"
+
+#include <string>
+#include <utility>
+
+#include "pipeline/frame_result_builder.h"
+
+namespace mocap::pipeline {
+
+Expected<std::unique_ptr<IdentifyStage>> IdentifyStage::create(std::uint32_t input_depth,
+                                                               StageContext& context,
+                                                               FrameProcessor& processor,
+                                                               rt::SlotPool<MsgSlot>& out) {
+  const PipelineOptions& o = context.options();
+  const std::int64_t tolerance = o.pair_by == PairBy::kTimestamp ? o.pair_tolerance_us * 1000 : 0;
+  auto pairer =
+      hal::FramePairer::create(hal::PairerConfig{tolerance, input_depth, processor.camera_count()});
+  if (!pairer) return pairer.error();
+  std::unique_ptr<IdentifyStage> s(
+      new IdentifyStage(context, processor, out, std::move(pairer).value()));
+  for (int c = 0; c < s->cameras_; ++c) {
+    const detect::BlobList proto = s->frame_->blobs[static_cast<std::size_t>(c)];
+    auto pool = rt::SlotPool<BlobSlot>::create(input_depth + 2, [&](std::uint32_t) {
+      BlobSlot slot;
+      slot.blobs = proto;  // the detector's capacity: no allocation when filled
+      return slot;
+    });
+    if (!pool) return pool.error();
+    s->inputs_.push_back(std::make_unique<rt::SlotPool<BlobSlot>>(std::move(pool).value()));
+  }
+  return s;
+}
+
+IdentifyStage::IdentifyStage(StageContext& context, FrameProcessor& processor,
+                             rt::SlotPool<MsgSlot>& out, hal::FramePairer pairer)
+    : context_(context),
+      processor_(processor),
+      out_(out),
+      cameras_(processor.camera_count()),
+      pairer_(std::move(pairer)),
+      frame_(std::make_unique<FrameOutput>(processor.make_output())) {}
+
+void IdentifyStage::count_unpaired(std::uint64_t sequence) noexcept {
+  if (!counting_) {
+    const std::uint64_t first = context_.first_sequence_plus_one();
+    next_sequence_ = first == 0 ? sequence : first - 1;
+    counting_ = true;
+  }
+  if (sequence >= next_sequence_) {
+    counters_.frames_unpaired.add(sequence - next_sequence_);
+    next_sequence_ = sequence + 1;
+  }
+}
+
+void IdentifyStage::release_set(const hal::FramePair& set) noexcept {
+  for (int c = 0; c < cameras_; ++c)
+    inputs_[static_cast<std::size_t>(c)]->release(set.cam[c].handle);
+}
+
+void IdentifyStage::run() noexcept {
+  context_.loop_start(StageId::kIdentify);
+  Doorbell& bell = context_.bell(StageId::kIdentify);
+  auto on_drop = [this](int c, const hal::PairEntry& e) {
+    rt::SlotPool<BlobSlot>& pool = *inputs_[static_cast<std::size_t>(c)];
+    const std::uint64_t sequence = pool[e.handle].sequence;
+    pool.release(e.handle);
+    context_.retire(sequence);
+  };
+  const bool by_time = context_.options().pair_by == PairBy::kTimestamp;
+  bool have_set = false;
+  hal::FramePair set{};
+  while (!context_.stopping()) {
+    const std::uint32_t seen = bell.snapshot();
+    for (int c = 0; c < cameras_; ++c) {
+      rt::SlotPool<BlobSlot>& pool = *inputs_[static_cast<std::size_t>(c)];
+      rt::SlotHandle h;
+      while (pool.pop(h)) {
+        hal::FramePair p;
+        const std::int64_t key =
+            by_time ? pool[h].capture_ns : static_cast<std::int64_t>(pool[h].sequence);
+        if (!pairer_.push(c, hal::PairEntry{key, h}, p, on_drop)) continue;
+        count_unpaired(sequence_of(p));
+        if (have_set) {  // drop-oldest: a newer set is complete
+          counters_.skipped.add();
+          const std::uint64_t dropped = sequence_of(set);
+          release_set(set);
+          context_.retire(dropped);
+        }
+        set = p;
+        have_set = true;
+      }
+    }
+    if (!have_set) {
+      bell.wait(seen, kIdleWaitNs);
+      continue;
+    }
+    have_set = false;
+    process(set);
+  }
+  context_.loop_end(StageId::kIdentify);
+}
+
+void IdentifyStage::process(const hal::FramePair& set) noexcept {
+  const std::int64_t t0 = monotonic_ns();
+  FrameOutput& out = *frame_;
+  for (int c = 0; c < cameras_; ++c) {
+    const auto ci = static_cast<std::size_t>(c);
+    BlobSlot& slot = (*inputs_[ci])[set.cam[c].handle];
+    std::swap(out.blobs[ci], slot.blobs);  // O(1), same capacities: no allocation
+    out.camera_present[ci] = slot.present;
+  }
+  const BlobSlot& first = (*inputs_[0])[set.cam[0].handle];
+  const std::uint64_t sequence = first.sequence;
+  const std::int64_t capture_ns = first.capture_ns;
+  release_set(set);
+  processor_.process_blobs(capture_ns, out);
+  library_.stereo.publish(kStereoFields, processor_.stereo_counters());
+  library_.identify.publish(kIdentifyFields, processor_.identify_counters());
+  if (const ChainCounters* chain = processor_.chain_counters()) {
+    library_.chain.publish(kChainFields, *chain);
+    library_.coverage.publish(kCoverageFields, *chain);
+  }
+  const PipelineOptions& o = context_.options();
+  if (o.observer) o.observer->observe(sequence, capture_ns, out);
+  rt::SlotHandle m;
+  if (out_.acquire(m)) {
+    make_frame_result(sequence, capture_ns, processor_.targets(), out, out_[m].frame);
+    if ((out_[m].frame.joints.flags & client::kFlagAllBodiesFound) == 0)
+      counters_.without_result.add();
+    out_.publish(m);
+    context_.bell(StageId::kPublish).ring();
+  } else {  // publish holds every slot (stalled sink)
+    counters_.no_slot.add();
+    context_.retire(sequence);
+  }
+  const std::int64_t t1 = monotonic_ns();
+  work_.record(t1 - t0);
+  latency_.record(t1 - capture_ns);
+}
+
+void IdentifyStage::drain() noexcept {
+  pairer_.flush([this](int c, const hal::PairEntry& e) {
+    inputs_[static_cast<std::size_t>(c)]->release(e.handle);
+  });
+  for (auto& pool : inputs_) {
+    rt::SlotHandle h;
+    while (pool->pop(h)) pool->release(h);
+  }
+}
+
+void IdentifyStage::report(rt::CounterReport& out) const {
+  const hal::PairerCounters& pc = pairer_.counters();
+  for (int c = 0; c < cameras_; ++c)
+    out.emplace_back(rt::counter_name("pair_unmatched_cam#", c), pc.unmatched[c].get());
+  for (int c = 0; c < cameras_; ++c)
+    out.emplace_back(rt::counter_name("pair_overflow_cam#", c), pc.overflow[c].get());
+  counters_.group.report(cameras_, out);
+  for (std::size_t i = 0; i < kStereoFields.size(); ++i)
+    out.emplace_back(std::string("stereo_") + kStereoFields[i].name, library_.stereo.get(i));
+  for (std::size_t i = 0; i < kIdentifyFields.size(); ++i)
+    out.emplace_back(std::string("identify_") + kIdentifyFields[i].name, library_.identify.get(i));
+  if (!processor_.has_model()) return;
+  for (std::size_t i = 0; i < kChainFields.size(); ++i)
+    out.emplace_back(std::string("chain_") + kChainFields[i].name, library_.chain.get(i));
+  const auto& joints = processor_.model().joints;
+  for (std::size_t j = 0; j < joints.size() && 2 * j + 1 < kCoverageFields.size(); ++j) {
+    out.emplace_back("coverage_" + joints[j].name + "_poses", library_.coverage.get(2 * j));
+    out.emplace_back("coverage_" + joints[j].name + "_chain", library_.coverage.get(2 * j + 1));
+  }
+}
+
+}  // namespace mocap::pipeline

@@ -1,0 +1,72 @@
+// Design: how the live pipeline is set up: its options (stage table, trigger pacing,
+// frame matching) and the seams through which tests and `mocap record` watch it
+// (FrameObserver, FrameTap, StageHooks). Every stage sees these options read-only; the
+// stage objects (capture_stage.h, detect_stage.h, identify_stage.h, publish_stage.h)
+// and the Pipeline that wires them (pipeline.h) include this header.
+#pragma once
+
+#include <cstdint>
+
+#include "core/capture_modes.h"
+#include "hal/camera.h"
+#include "pipeline/stage_table.h"
+#include "track/frame_processor.h"
+
+namespace mocap::pipeline {
+
+using mocap::TriggerPacing;  // core/capture_modes.h
+
+enum class PairBy : std::uint8_t {
+  kSequence,   // trigger sequence numbers must match (triggered cameras)
+  kTimestamp,  // sensor timestamps within pair_tolerance_us (free-running cameras)
+};
+
+// Called on the identify thread with every processed frame (tests, recording).
+class FrameObserver {
+ public:
+  virtual ~FrameObserver() = default;
+  virtual void observe(std::uint64_t sequence, std::int64_t capture_ns,
+                       const FrameOutput& out) noexcept = 0;
+};
+
+// Called on the capture thread with every frame a camera delivered (missing replay frames
+// included), right after it was dequeued and before it goes to its detector: `mocap
+// record` copies the images here (pipeline/record). Must be noexcept, allocation-free and
+// return quickly (periodic pacing: it must never wait; lockstep pacing may wait briefly,
+// as the trigger does).
+class FrameTap {
+ public:
+  virtual ~FrameTap() = default;
+  virtual void on_frame(int camera, const hal::Frame& frame) noexcept = 0;
+};
+
+// Called on each stage thread right before its loop starts and right after it ends
+// (tests count the thread's heap allocations in between).
+class StageHooks {
+ public:
+  virtual ~StageHooks() = default;
+  virtual void on_loop_start(StageId stage) noexcept = 0;
+  virtual void on_loop_end(StageId stage) noexcept = 0;
+};
+
+struct PipelineOptions {
+  StageTable stages{};             // the rule per stage kind + per-camera detect overrides
+  int cpu_count = 0;               // CPUs the detect rule spreads over; 0: this machine's (online)
+  bool realtime = true;            // apply the table's CPU pinning and SCHED_FIFO (fallback noted)
+  bool lock_memory = true;         // mlockall (fallback noted)
+  double trigger_rate_hz = 100.0;  // software-triggered cameras
+  TriggerPacing pacing = TriggerPacing::kPeriodic;
+  std::uint64_t max_frames = 0;  // stop triggering after this many (0: unlimited)
+  // Longest wait for a triggered frame; the capture also never waits past the next
+  // trigger, so a stalled camera cannot slow the other one down.
+  int dequeue_timeout_ms = 20;
+  PairBy pair_by = PairBy::kSequence;
+  // kTimestamp only: two frames pair when their timestamps differ by at most this; must
+  // be below half the frame period.
+  std::int64_t pair_tolerance_us = 1000;
+  FrameObserver* observer = nullptr;
+  StageHooks* hooks = nullptr;
+  FrameTap* tap = nullptr;  // `mocap record`: every delivered frame, capture thread
+};
+
+}  // namespace mocap::pipeline
