@@ -140,6 +140,35 @@ bool MultiViewMerger::is_unfit_pairing(int i, int o) const noexcept {
   return any_unfit;
 }
 
+bool MultiViewMerger::split_from_owners(Point3& h, const int* owners, int n_owners,
+                                        const PointList& out,
+                                        const Vec2* const* px) const noexcept {
+  const double diameter_mm = 2.0 * config_.marker_radius_mm;
+  if (diameter_mm <= 0.0) return false;
+  BlobRefs own = h.blob_index;  // h's views whose blob no taken point uses
+  for (int k = 0; k < n_owners; ++k) {
+    const Point3& o = out[owners[k]];
+    int shared = 0;
+    for (int c = 0; c < camera_count(); ++c) {
+      if (h.blob_index[c] < 0 || h.blob_index[c] != o.blob_index[c]) continue;
+      own[c] = -1;
+      ++shared;
+    }
+    // The owner must stand on two views of its own, and be another ball: two balls are
+    // at least a diameter apart.
+    if (o.blob_index.count() - shared < 2) return false;
+    if ((o.X_world - h.X_world).norm() < diameter_mm) return false;
+  }
+  if (own.count() < 2) return false;
+  Point3 p = h;
+  p.blob_index = own;
+  if (!refit(p, px) || p.reproj_px > config_.gate_px) return false;
+  for (int k = 0; k < n_owners; ++k)
+    if ((out[owners[k]].X_world - p.X_world).norm() < diameter_mm) return false;
+  h = p;
+  return true;
+}
+
 bool MultiViewMerger::refit(Point3& p, const Vec2* const* px) const noexcept {
   const CameraModel* cams[kMaxCameras];
   Vec2 obs[kMaxCameras];
@@ -247,6 +276,11 @@ bool MultiViewMerger::process(const Vec2* const* px, const int* n, const PointLi
     if (n_owners == 1 && is_unfit_pairing(i, owners[0])) {
       ++counters_.unfit_pairings;  // the owner's marker, paired through its unfit view
       continue;
+    }
+    if (n_owners > 0 && split_from_owners(h, owners, n_owners, out, px)) {
+      ++counters_.shared_views_split;  // another marker's blob merged with this one's
+      n_owners = 0;
+      richer_owner = false;
     }
     if (richer_owner) {
       ++counters_.ghosts_rejected;  // a blob of a point that more cameras confirm

@@ -21,6 +21,11 @@
 // dropped within that bound, is recorded as the point's unfit view; a later hypothesis
 // made only of the point's blobs and its unfit views is that marker again (`merged`),
 // not a rival.
+// Two balls whose images merge in some camera: that camera's one blob lies within gate_px
+// of both balls' projections, so both points take it. The second one (in acceptance
+// order) gives it up when it still stands on two views no taken point uses and the two
+// points are at least a ball's diameter apart (two balls cannot be closer): it is refit
+// over its own views and reported, not flagged as an ambiguous rival of the first.
 // A 2-view point that no third camera confirms is still reported: under occlusion a
 // camera that should see a marker often does not, so absence is no evidence, and a
 // consistent pair of stray blobs is a point like any other for the identification,
@@ -62,6 +67,7 @@ struct MultiViewCounters {
   std::uint64_t merged = 0;               // the same point from another camera pair
   std::uint64_t unfit_views = 0;          // blobs recorded as a point's unfit view
   std::uint64_t unfit_pairings = 0;       // hypotheses made of a point and its unfit views
+  std::uint64_t shared_views_split = 0;   // points that gave up views another point took
   std::uint64_t ghosts_rejected = 0;      // lost to a point seen by more cameras
   std::uint64_t ambiguous = 0;            // emitted points flagged ambiguous
   std::uint64_t points = 0;               // emitted points
@@ -98,6 +104,11 @@ class MultiViewMerger {
   double unfit_gate_px(int c, const Vec3& X_world) const noexcept;
   // Whether hypothesis i consists of taken point o's blobs and unfit views only.
   bool is_unfit_pairing(int i, int o) const noexcept;
+  // Two balls whose images merge in some views: h keeps only the views no taken point
+  // uses, when each side stands on two views of its own and they are a ball's diameter
+  // apart; refits h over them. False: h unchanged.
+  bool split_from_owners(Point3& h, const int* owners, int n_owners, const PointList& out,
+                         const Vec2* const* px) const noexcept;
 
   std::vector<CameraModel> cams_;
   MultiViewConfig config_;

@@ -37,6 +37,7 @@ std::vector<std::pair<std::string, std::uint64_t>> collect_counters(const FrameP
     c.emplace_back("multiview_ambiguous", m.ambiguous);
     c.emplace_back("multiview_hypothesis_overflow", m.hypothesis_overflow);
     c.emplace_back("multiview_point_overflow", m.point_overflow);
+    c.emplace_back("multiview_shared_views_split", m.shared_views_split);
   }
   const IdentifyCounters& i = p.identify_counters();
   c.emplace_back("identify_bodies_found", i.bodies_found);

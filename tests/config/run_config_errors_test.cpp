@@ -132,7 +132,7 @@ const ErrorCase kCases[] = {
      "  - {backend: v4l2, device: /dev/video1, width: 640, height: 480}\n" ASSETS,
      "cameras[1].width: 640x480 does not match the rig's camera 'cam1' (1032x776)"},
     {"NegativeTriggerRate", "pipeline: {trigger_rate_hz: -5}\n",
-     "pipeline.trigger_rate_hz: must be in [0, 10000], got -5 (line 1)"},
+     "pipeline.trigger_rate_hz: must be in [0.01, 10000], got -5 (line 1)"},
     {"BadPacing", "pipeline: {pacing: fast}\n",
      "pipeline.pacing: expected periodic|lockstep, got 'fast' (line 1)"},
     {"RealtimeNotABool", "pipeline: {realtime: yes}\n",

@@ -67,6 +67,21 @@ TEST(LiveSetup, CommandLineOverridesTheFile) {
   auto bad = resolve_run_config(dir.file("m.yaml"), cli);
   ASSERT_FALSE(bad);
   EXPECT_EQ(bad.error().message, "--udp: expected HOST:PORT, got 'nohost'");
+  // The flags are checked by the configuration's own checks (the same ranges as the keys).
+  cli.udp.reset();
+  cli.rate_hz = 0.0;
+  auto slow = resolve_run_config(dir.file("m.yaml"), cli);
+  ASSERT_FALSE(slow);
+  EXPECT_EQ(slow.error().message, "--rate: must be in [0.01, 10000] Hz, got 0");
+  cli.rate_hz = 10000.0;  // the largest rate the file's key accepts is a valid flag too
+  EXPECT_TRUE(resolve_run_config(dir.file("m.yaml"), cli));
+  cli.loop_frames = 1;
+  auto short_loop = resolve_run_config(dir.file("m.yaml"), cli);
+  ASSERT_FALSE(short_loop);
+  EXPECT_EQ(short_loop.error().message, "--loop-frames: must be in 2..2000, got 1");
+  cli.loop_frames.reset();
+  cli.multicast_ttl = 300;  // checked by the udp output, as the file's option would be
+  EXPECT_FALSE(resolve_run_config(dir.file("m.yaml"), cli));
   auto missing = resolve_run_config(dir.file("absent.yaml"), CliOverrides{});
   ASSERT_FALSE(missing);
   EXPECT_NE(missing.error().message.find("absent.yaml: cannot open"), std::string::npos);

@@ -4,7 +4,8 @@
 // triangulators propose; the merger must give every point seen by 3 or more cameras
 // with exactly its true blobs, never a reported point made of blobs of different
 // markers (a ghost), more accurate points than any pair alone, and, with two cameras,
-// the pair's candidates unchanged. process() allocates nothing.
+// the pair's candidates unchanged; two balls on one ray of a camera are both reported
+// when a diameter apart. process() allocates nothing.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -233,6 +234,69 @@ TEST(MultiView, TwoCamerasPassThePairUnchanged) {
       EXPECT_EQ(st.out[i].ambiguous, st.pair_out[0][i].ambiguous);
     }
   }
+}
+
+// Two balls on one ray of camera 2 (the far one hidden behind the near one there: one
+// blob), each seen on its own by cameras 0, 1 and 3. Both points take camera 2's blob;
+// they are a ball's diameter or more apart, so the second gives the blob up and both are
+// reported. Balls closer than a diameter cannot both exist: they stay exclusive rivals.
+struct OneRayFrame {
+  std::vector<std::vector<Vec2>> px;
+  Vec3 near, far;
+};
+
+OneRayFrame one_ray_frame(const Rig& rig, double apart_mm) {
+  OneRayFrame f;
+  f.near = Vec3(20.0, -10.0, 1000.0);
+  const Vec3 C2 = rig.cameras[2].center_world();
+  f.far = f.near + (f.near - C2).normalized() * apart_mm;
+  f.px.resize(rig.cameras.size());
+  for (std::size_t c = 0; c < rig.cameras.size(); ++c) {
+    Vec2 a, b;
+    EXPECT_TRUE(project(rig.cameras[c], f.near, a) && project(rig.cameras[c], f.far, b));
+    f.px[c].push_back(a);
+    if (c != 2) f.px[c].push_back(b);  // camera 2: the far ball is behind the near one
+  }
+  return f;
+}
+
+int reported_near(const PointList& out, const Vec3& X) {
+  int n = 0;
+  for (const Point3& p : out) n += p.reported && (p.X_world - X).norm() < 0.01;
+  return n;
+}
+
+TEST(MultiView, TwoBallsOnOneRayOfACameraAreBothReported) {
+  const Rig rig = test::ring_rig();
+  MultiViewConfig config;
+  config.marker_radius_mm = 7.0;
+  Stage st(rig, config);
+  const OneRayFrame f = one_ray_frame(rig, 150.0);
+  Frame frame;
+  frame.px = f.px;
+  st.run(frame);
+  EXPECT_EQ(reported_near(st.out, f.near), 1);
+  EXPECT_EQ(reported_near(st.out, f.far), 1);
+  int with_cam2 = 0;
+  for (const Point3& p : st.out) {
+    EXPECT_FALSE(p.ambiguous);
+    with_cam2 += p.blob_index[2] >= 0;
+  }
+  EXPECT_EQ(with_cam2, 1) << "camera 2's one blob belongs to one point";
+  EXPECT_EQ(st.merger.counters().shared_views_split, 1u);
+}
+
+TEST(MultiView, BallsCloserThanADiameterStayRivals) {
+  const Rig rig = test::ring_rig();
+  MultiViewConfig config;
+  config.marker_radius_mm = 7.0;
+  Stage st(rig, config);
+  const OneRayFrame f = one_ray_frame(rig, 10.0);  // two 14 mm balls would overlap
+  Frame frame;
+  frame.px = f.px;
+  st.run(frame);
+  EXPECT_EQ(st.merger.counters().shared_views_split, 0u);
+  EXPECT_LE(reported_near(st.out, f.near) + reported_near(st.out, f.far), 1);
 }
 
 TEST(MultiView, SetupErrors) {
