@@ -142,10 +142,9 @@ TEST(OfflineTracker, FourCamerasAroundTheRobot) {
   // The simulator's built-in 4-camera arc (docs/simulator.md) on the stalks layout (the
   // one the 2-camera acceptance test uses), where limbs hide markers from some cameras
   // and not others. Every camera takes part: points.csv has the `cameras` column, and
-  // points seen by 3 or 4 cameras are refined over all of them. The bounds are what
-  // the tracker meets today (60 frames: recall 99.0 %, bodies 98-100 %, RMSE 0.042 mm),
-  // not yet the 99 % for 4-camera recordings (docs/stereo.md: markers whose
-  // images merge in one camera become rivals).
+  // points seen by 3 or 4 cameras are refined over all of them. Recall is held to the
+  // issue's 99 % (60 frames: 100 %, RMSE 0.042 mm); bodies to 95 % (60 frames: 98-100 %;
+  // docs/stereo.md).
   sim::SimOptions so;
   so.scene = sim::SceneKind::kStalks;
   so.cameras = 4;
@@ -158,7 +157,7 @@ TEST(OfflineTracker, FourCamerasAroundTheRobot) {
   const AccuracyReport& a = *r.accuracy;
   std::printf("%s", format_track_summary(r).c_str());
   ASSERT_GT(a.marker_views, 300);
-  EXPECT_GE(static_cast<double>(a.markers_recalled), 0.98 * static_cast<double>(a.marker_views));
+  EXPECT_GE(static_cast<double>(a.markers_recalled), 0.99 * static_cast<double>(a.marker_views));
   EXPECT_LE(a.point_rmse_mm, 0.08);
   for (const BodyAccuracy& b : a.bodies) {
     SCOPED_TRACE(b.body);
