@@ -9,6 +9,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
+#include "core/camera_set.h"
 #include "pipeline/foxglove/blob_overlay.h"
 #include "pipeline/foxglove/encode.h"
 
@@ -209,6 +210,34 @@ TEST(FoxgloveEncode, ChannelsAdvertiseValidJsonSchemas) {
     const json s = json::parse(c.schema);
     EXPECT_EQ(s["type"], "object") << c.topic;
   }
+}
+
+// A rig of 8 cameras (the most a rig may have): one blob channel per camera, in rig
+// order, ids consecutive after the fixed channels; each camera's overlay is its own.
+TEST(FoxgloveEncode, EveryCameraOfAnEightCameraRigHasItsBlobChannel) {
+  Rig rig;
+  for (int k = 0; k < kMaxCameras; ++k) {
+    CameraModel c;
+    c.name = "cam" + std::to_string(k);
+    c.width = 640 + 64 * k;  // sizes differ per camera
+    c.height = 480;
+    rig.cameras.push_back(c);
+  }
+  const FoxgloveScene scene = make_scene(two_bodies(), nullptr, &rig).value();
+  const auto channels = live_view_channels(scene);
+  ASSERT_EQ(channels.size(), 3u + static_cast<std::size_t>(kMaxCameras));
+  for (int k = 0; k < kMaxCameras; ++k) {
+    const ChannelInfo& ch = channels[3 + static_cast<std::size_t>(k)];
+    EXPECT_EQ(ch.topic, "/cam" + std::to_string(k) + "/blobs");
+    EXPECT_EQ(ch.id, kChannelBlobsFirst + static_cast<std::uint32_t>(k));
+  }
+  auto f = std::make_unique<publish::FrameResult>();
+  f->camera_count = kMaxCameras;
+  f->cameras[7].present = 1;
+  const json last = json::parse(encode_blob_overlay(scene, *f, 7, 0));
+  EXPECT_EQ(last["frame_id"], "cam7");
+  EXPECT_EQ(last["width"], (640 + 64 * 7) / kBlobOverlayScale);
+  EXPECT_TRUE(encode_blob_overlay(scene, *f, kMaxCameras, 0).empty());
 }
 
 }  // namespace
