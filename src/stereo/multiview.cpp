@@ -34,7 +34,6 @@ MultiViewMerger::MultiViewMerger(const Rig& rig, const MultiViewConfig& config)
       hyp_(static_cast<std::size_t>(config.max_hypotheses)),
       views_(static_cast<std::size_t>(config.max_hypotheses)),
       extended_(static_cast<std::size_t>(config.max_hypotheses)),
-      unfit_(static_cast<std::size_t>(config.max_hypotheses)),
       out_hyp_(static_cast<std::size_t>(config.max_hypotheses)),
       order_(static_cast<std::size_t>(config.max_hypotheses)),
       taken_by_(rig.cameras.size() * static_cast<std::size_t>(config.max_points_per_camera)) {}
@@ -48,11 +47,9 @@ double MultiViewMerger::unfit_gate_px(int c, const Vec3& X_world) const noexcept
 
 // Adds every camera not yet used whose nearest blob lies within the gate of the
 // projection (the nearest one only: two blobs within 2 px are one marker's split); a
-// nearest blob beyond the gate but within the unfit gate is recorded as an unfit view.
+// nearest blob beyond the gate but within the unfit gate is counted as an unfit view.
 void MultiViewMerger::extend(int i, const Vec2* const* px, const int* n) noexcept {
   Point3& h = hyp_[static_cast<std::size_t>(i)];
-  BlobRefs& unfit = unfit_[static_cast<std::size_t>(i)];
-  unfit = BlobRefs{};
   for (int c = 0; c < camera_count(); ++c) {
     if (h.blob_index[c] >= 0) continue;
     Vec2 q;
@@ -73,7 +70,6 @@ void MultiViewMerger::extend(int i, const Vec2* const* px, const int* n) noexcep
       h.blob_index[c] = static_cast<std::int16_t>(best);
       ++counters_.views_added;
     } else {
-      unfit[c] = static_cast<std::int16_t>(best);
       ++counters_.unfit_views;
     }
   }
@@ -81,7 +77,7 @@ void MultiViewMerger::extend(int i, const Vec2* const* px, const int* n) noexcep
 
 // Gauss-Newton over the views; the worst view beyond the gate is dropped (while more
 // than two remain) and the point refined again. A dropped view within the unfit gate is
-// recorded as an unfit view.
+// counted as an unfit view.
 void MultiViewMerger::refine(int i, const Vec2* const* px) noexcept {
   Point3& h = hyp_[static_cast<std::size_t>(i)];
   for (;;) {
@@ -116,25 +112,26 @@ void MultiViewMerger::refine(int i, const Vec2* const* px) noexcept {
       return;
     }
     const int c = cam_of[worst];
-    if (worst_d <= unfit_gate_px(c, X)) {
-      unfit_[static_cast<std::size_t>(i)][c] = h.blob_index[c];
-      ++counters_.unfit_views;
-    }
+    if (worst_d <= unfit_gate_px(c, X)) ++counters_.unfit_views;
     h.blob_index[c] = -1;
     ++counters_.views_dropped;
   }
 }
 
-bool MultiViewMerger::is_unfit_pairing(int i, int o) const noexcept {
+bool MultiViewMerger::is_unfit_pairing(int i, const Point3& o,
+                                       const Vec2* const* px) const noexcept {
   const BlobRefs& mine = hyp_[static_cast<std::size_t>(i)].blob_index;
-  const int oh = out_hyp_[static_cast<std::size_t>(o)];
-  const BlobRefs& used = hyp_[static_cast<std::size_t>(oh)].blob_index;
-  const BlobRefs& unfit = unfit_[static_cast<std::size_t>(oh)];
   bool any_unfit = false;
   for (int c = 0; c < camera_count(); ++c) {
     const int j = mine[c];
-    if (j < 0 || j == used[c]) continue;
-    if (j != unfit[c]) return false;
+    if (j < 0 || j == o.blob_index[c]) continue;
+    if (o.blob_index[c] >= 0) return false;  // o sees another blob there: a rival view
+    // Within the ball's image (+ the gate) around o's projection: part of o's image, a
+    // partly hidden or split piece of it.
+    Vec2 q;
+    if (!project(cams_[static_cast<std::size_t>(c)], o.X_world, q)) return false;
+    const double gate = unfit_gate_px(c, o.X_world);
+    if ((px[c][j] - q).squaredNorm() > gate * gate) return false;
     any_unfit = true;
   }
   return any_unfit;
@@ -230,7 +227,6 @@ bool MultiViewMerger::process(const Vec2* const* px, const int* n, const PointLi
       if (extended_[static_cast<std::size_t>(k)] == h.blob_index) same = k;
     if (same >= 0) {
       h = hyp_[static_cast<std::size_t>(same)];  // refined already
-      unfit_[static_cast<std::size_t>(i)] = unfit_[static_cast<std::size_t>(same)];
     } else {
       refine(i, px);
     }
@@ -273,7 +269,7 @@ bool MultiViewMerger::process(const Vec2* const* px, const int* n, const PointLi
       ++counters_.merged;  // the same blobs: the same point from another pair
       continue;
     }
-    if (n_owners == 1 && is_unfit_pairing(i, owners[0])) {
+    if (n_owners == 1 && is_unfit_pairing(i, out[owners[0]], px)) {
       ++counters_.unfit_pairings;  // the owner's marker, paired through its unfit view
       continue;
     }

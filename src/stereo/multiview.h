@@ -16,11 +16,11 @@
 // Unfit views of the same marker: a ball partly hidden from one camera has a centroid
 // shifted by up to its image radius, beyond gate_px, so that camera's blob pairs with each
 // of the other views into 2-view hypotheses a few millimetres off the marker (a triangle
-// of pairings). A blob of a camera not in a point, within gate_px + the ball's image
-// radius (fx * marker_radius_mm / depth) of its projection, or a view the refinement
-// dropped within that bound, is recorded as the point's unfit view; a later hypothesis
-// made only of the point's blobs and its unfit views is that marker again (`merged`),
-// not a rival.
+// of pairings), and the detector may have split that blob in pieces. A later hypothesis
+// made only of a taken point's blobs and, in cameras where the point has no view, blobs
+// within gate_px + the ball's image radius (fx * marker_radius_mm / depth) of its
+// projection, is that marker again (`unfit_pairings`), not a rival: the test is
+// geometric, so every piece of a split blob counts, not only the nearest.
 // Two balls whose images merge in some camera: that camera's one blob lies within gate_px
 // of both balls' projections, so both points take it. The second one (in acceptance
 // order) gives it up when it still stands on two views no taken point uses and the two
@@ -54,7 +54,7 @@ struct MultiViewConfig {
   int max_points_per_camera = 256;  // blobs per camera considered (as StereoConfig)
   int max_hypotheses = 2048;        // pairwise candidates considered per frame
   // Radius of the marker balls (mm; the targets' marker_diameter / 2): bounds how far a
-  // partly hidden ball's centroid can move. 0: no unfit views are recorded.
+  // partly hidden ball's centroid can move. 0: only blobs within gate_px count.
   double marker_radius_mm = 0.0;
 };
 
@@ -65,8 +65,8 @@ struct MultiViewCounters {
   std::uint64_t views_added = 0;          // third and further views found by projection
   std::uint64_t views_dropped = 0;        // views removed as outliers after refinement
   std::uint64_t merged = 0;               // the same point from another camera pair
-  std::uint64_t unfit_views = 0;          // blobs recorded as a point's unfit view
-  std::uint64_t unfit_pairings = 0;       // hypotheses made of a point and its unfit views
+  std::uint64_t unfit_views = 0;          // nearest blobs beyond the gate, within the ball's image
+  std::uint64_t unfit_pairings = 0;       // hypotheses made of a point and blobs of its image
   std::uint64_t shared_views_split = 0;   // points that gave up views another point took
   std::uint64_t ghosts_rejected = 0;      // lost to a point seen by more cameras
   std::uint64_t ambiguous = 0;            // emitted points flagged ambiguous
@@ -102,8 +102,9 @@ class MultiViewMerger {
   void refine(int i, const Vec2* const* px) noexcept;
   // gate_px plus the marker's image radius in camera c at X_world (0: behind).
   double unfit_gate_px(int c, const Vec3& X_world) const noexcept;
-  // Whether hypothesis i consists of taken point o's blobs and unfit views only.
-  bool is_unfit_pairing(int i, int o) const noexcept;
+  // Whether hypothesis i consists of taken point o's blobs and, in cameras where o has
+  // no view, blobs within o's image (unfit_gate_px of its projection) only.
+  bool is_unfit_pairing(int i, const Point3& o, const Vec2* const* px) const noexcept;
   // Two balls whose images merge in some views: h keeps only the views no taken point
   // uses, when each side stands on two views of its own and they are a ball's diameter
   // apart; refits h over them. False: h unchanged.
@@ -115,7 +116,6 @@ class MultiViewMerger {
   std::vector<Point3> hyp_;         // workspace: this frame's hypotheses
   std::vector<int> views_;          // views per hypothesis
   std::vector<BlobRefs> extended_;  // blobs before refinement
-  std::vector<BlobRefs> unfit_;     // per hypothesis: its unfit views
   std::vector<int> out_hyp_;        // per output point: the hypothesis it came from
   std::vector<int> order_;          // hypotheses in acceptance order
   std::vector<int> taken_by_;       // [camera * max_points_per_camera + blob]: output index
