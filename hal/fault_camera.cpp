@@ -5,6 +5,14 @@
 #include <algorithm>
 
 namespace mocap::hal {
+namespace {
+
+// What a dequeue of a silent camera does: wait its whole timeout.
+void wait_ms(int timeout_ms) noexcept {
+  sleep_until_ns(monotonic_ns() + static_cast<std::int64_t>(std::max(timeout_ms, 0)) * 1'000'000);
+}
+
+}  // namespace
 
 const char* to_string(Fault f) noexcept {
   switch (f) {
@@ -24,6 +32,8 @@ const char* to_string(Fault f) noexcept {
       return "timestamp_jump";
     case Fault::kReplaceImage:
       return "replace_image";
+    case Fault::kStall:
+      return "stall";
   }
   return "unknown";
 }
@@ -51,6 +61,15 @@ Expected<std::unique_ptr<FaultCamera>> FaultCamera::wrap(Camera& inner,
   return cam;
 }
 
+Expected<std::unique_ptr<FaultCamera>> FaultCamera::wrap(std::unique_ptr<Camera> inner,
+                                                         const std::vector<FaultRule>& rules,
+                                                         const Image* substitute) {
+  if (!inner) return make_error("FaultCamera", "inner", "no camera to wrap");
+  auto cam = wrap(*inner, rules, substitute);
+  if (cam) (*cam)->owned_ = std::move(inner);
+  return cam;
+}
+
 Expected<void> FaultCamera::configure(const CameraConfig& config) {
   return inner_.configure(config);
 }
@@ -65,6 +84,7 @@ Expected<void> FaultCamera::start() {
   }
   swap_pending_ = false;
   has_last_ = false;
+  stall_calls_.fill(0);
   return inner_.start();
 }
 
@@ -79,12 +99,27 @@ std::uint64_t FaultCamera::injected_total() const noexcept {
 const FaultRule* FaultCamera::rule_for(std::uint64_t index) const noexcept {
   for (std::size_t i = 0; i < rule_count_; ++i) {
     const FaultRule& r = rules_[i];
-    if (index >= r.first && index - r.first < r.count) return &r;
+    if (r.fault != Fault::kStall && index >= r.first && index - r.first < r.count) return &r;
   }
   return nullptr;
 }
 
+bool FaultCamera::stalled(std::uint64_t index) noexcept {
+  for (std::size_t i = 0; i < rule_count_; ++i) {
+    const FaultRule& r = rules_[i];
+    if (r.fault != Fault::kStall || r.first != index || stall_calls_[i] >= r.count) continue;
+    if (r.count != FaultRule::kForever) ++stall_calls_[i];
+    return true;
+  }
+  return false;
+}
+
 CameraStatus FaultCamera::dequeue(Frame& out, int timeout_ms) noexcept {
+  if (stalled(seen_.get())) {  // the inner camera is not asked: its frames pile up there
+    injected_[static_cast<std::size_t>(Fault::kStall)].add();
+    wait_ms(timeout_ms);
+    return CameraStatus::kTimeout;
+  }
   const CameraStatus st = inner_.dequeue(out, timeout_ms);
   if (st != CameraStatus::kOk) return st;
   return apply(out, timeout_ms);
@@ -107,8 +142,7 @@ CameraStatus FaultCamera::apply(Frame& f, int timeout_ms) noexcept {
         return CameraStatus::kCorruptFrame;
       case Fault::kTimeout:  // a stopped camera: the call waits its whole timeout
         inner_.release(f);
-        sleep_until_ns(monotonic_ns() +
-                       static_cast<std::int64_t>(std::max(timeout_ms, 0)) * 1'000'000);
+        wait_ms(timeout_ms);
         return CameraStatus::kTimeout;
       case Fault::kTruncatedFrame:
         f.image.height = static_cast<int>(std::min<std::int64_t>(r->value, f.image.height));
@@ -127,6 +161,8 @@ CameraStatus FaultCamera::apply(Frame& f, int timeout_ms) noexcept {
         break;
       case Fault::kReplaceImage:
         f.image = substitute_->view();
+        break;
+      case Fault::kStall:  // held before the inner dequeue (stalled()); never a frame rule
         break;
     }
   }

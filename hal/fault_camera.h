@@ -12,6 +12,14 @@
 //   kTimestampJump           : `value` ns are added to the timestamp (a clock step)
 //   kReplaceImage            : the image is replaced by a substitute (e.g. an image full
 //                              of blobs that overflows the detector)
+//   kStall                   : a camera whose cable was pulled without the driver
+//                              noticing: once `first` good frames were delivered, the next
+//                              `count` dequeue calls (kForever: all of them) wait timeout_ms
+//                              and report kTimeout without asking the inner camera, whose
+//                              frames pile up there (its own drops); then it resumes.
+//                              Frames already dequeued are released normally. The
+//                              configuration key fault_injection.stall_after_frames of
+//                              `mocap run` / `mocap record` is such a rule on camera 0
 // Rules are indexed by the inner camera's good frames (0 = the first frame dequeued
 // with kOk), so a schedule is deterministic whatever the timing. Frames keep their
 // inner buffer_index, so release() goes straight to the inner camera; lost frames are
@@ -39,14 +47,16 @@ enum class Fault : std::uint8_t {
   kSwapOrder,
   kTimestampJump,
   kReplaceImage,
+  kStall,
 };
-inline constexpr std::size_t kFaultCount = 8;
+inline constexpr std::size_t kFaultCount = 9;
 const char* to_string(Fault f) noexcept;
 
 struct FaultRule {
+  static constexpr std::uint64_t kForever = ~std::uint64_t{0};
   Fault fault = Fault::kIoError;
   std::uint64_t first = 0;  // index of the first inner good frame affected
-  std::uint64_t count = 1;  // consecutive frames affected
+  std::uint64_t count = 1;  // consecutive frames affected (kStall: dequeue calls)
   std::int64_t value = 0;   // kTruncatedFrame: rows kept; kTimestampJump: ns added
 };
 
@@ -57,6 +67,10 @@ class FaultCamera final : public Camera {
   // `inner` must outlive the wrapper. `substitute` (kReplaceImage) must match the
   // inner camera's configured size and format and outlive the wrapper.
   static Expected<std::unique_ptr<FaultCamera>> wrap(Camera& inner,
+                                                     const std::vector<FaultRule>& rules,
+                                                     const Image* substitute = nullptr);
+  // The same, owning the inner camera (the wrapper takes its place in a camera list).
+  static Expected<std::unique_ptr<FaultCamera>> wrap(std::unique_ptr<Camera> inner,
                                                      const std::vector<FaultRule>& rules,
                                                      const Image* substitute = nullptr);
 
@@ -82,15 +96,20 @@ class FaultCamera final : public Camera {
 
  private:
   FaultCamera(Camera& inner, const Image* substitute) noexcept;
-  // The rule covering inner frame `index` (the first in the list wins), or nullptr.
+  // The frame rule covering inner frame `index` (the first in the list wins; kStall
+  // rules excluded), or nullptr.
   const FaultRule* rule_for(std::uint64_t index) const noexcept;
+  // True when a kStall rule holds the camera before inner frame `index` (and counts the call).
+  bool stalled(std::uint64_t index) noexcept;
   CameraStatus apply(Frame& f, int timeout_ms) noexcept;
 
+  std::unique_ptr<Camera> owned_;  // the inner camera when the wrapper owns it
   Camera& inner_;
   std::string name_;
   const Image* substitute_ = nullptr;
   std::array<FaultRule, kMaxRules> rules_{};
   std::size_t rule_count_ = 0;
+  std::array<std::uint64_t, kMaxRules> stall_calls_{};  // kStall: calls held so far
   std::array<rt::Counter, kFaultCount> injected_{};
   rt::Counter seen_;
   bool swap_pending_ = false;  // kSwapOrder: the next frame takes the previous number

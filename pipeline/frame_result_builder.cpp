@@ -26,8 +26,7 @@ void make_joints_message(std::uint64_t sequence, std::int64_t capture_ns, const 
     const kinematics::JointAngle& a = out.angles.joints[j];
     client::JointRecord& r = msg.joints[j];
     r.index = static_cast<std::uint16_t>(j);
-    r.type = static_cast<std::uint8_t>(a.type == JointType::kHinge ? client::JointKind::kHinge
-                                                                   : client::JointKind::kBall);
+    r.type = static_cast<std::uint8_t>(a.type);  // client::JointKind is JointType
     r.valid = a.valid ? 1 : 0;
     r.a[0] = static_cast<float>(a.a0);
     r.a[1] = static_cast<float>(a.a1);

@@ -5,9 +5,9 @@
 #include <cstring>
 
 #include "config/tracking_assets.h"
+#include "hal/fault_camera.h"
 #include "hal/replay_camera.h"
 #include "hal/v4l2_camera.h"
-#include "pipeline/service/stalling_camera.h"
 #ifdef MOCAP_HAVE_LIBCAMERA
 #include "hal/libcamera_camera.h"
 #endif
@@ -229,7 +229,11 @@ Expected<std::unique_ptr<LiveSetup>> LiveSetup::create(const config::RunConfig& 
           "fault injection: camera 0 stalls after " +
               std::to_string(cfg.faults.stall_after_frames) + " frames",
           command);
-      cams[c] = std::make_unique<StallingCamera>(std::move(cams[c]), cfg.faults.stall_after_frames);
+      const hal::FaultRule stall{hal::Fault::kStall, cfg.faults.stall_after_frames,
+                                 hal::FaultRule::kForever, 0};
+      auto faulty = hal::FaultCamera::wrap(std::move(cams[c]), {stall});
+      if (!faulty) return faulty.error();
+      cams[c] = std::move(faulty).value();
     }
   }
   s->cams_ = std::move(cams);

@@ -2,16 +2,20 @@
 // for every frame reaching the end of the pipeline, over iceoryx (service "mocap",
 // instance "tracker", event "joints": this struct is the payload) and UDP (the spec's
 // datagram v1 carries the same fields). Consumers include this header only; it depends
-// on nothing but <cstdint>. Trivially copyable, no pointers (iceoryx requirement).
+// on nothing but <cstdint> and core/joint_type.h (the project's one joint type, installed
+// with it). Trivially copyable, no pointers (iceoryx requirement).
 #pragma once
 
 #include <cstdint>
+
+#include "core/joint_type.h"
 
 namespace mocap::client {
 
 inline constexpr std::uint16_t kMaxJoints = 32;
 
-enum class JointKind : std::uint8_t { kBall = 0, kHinge = 1 };
+// The joint type of a JointRecord: mocap::JointType (wire values kBall = 0, kHinge = 1).
+using JointKind = ::mocap::JointType;
 
 struct JointRecord {
   std::uint16_t index = 0;                // position of the joint in model.yaml

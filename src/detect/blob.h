@@ -1,14 +1,15 @@
 // Design: the detector's output types. A Blob is one marker image: sub-pixel
 // centroid (pixel centre of the top-left pixel = (0,0), as in camera/camera_model.h),
-// size, bounding box, peak and second-moment shape, plus flags. BlobList is a
-// fixed-capacity array whose storage is allocated once at setup; the hot path only
-// overwrites it and counts what did not fit. DetectorCounters accumulate over the
-// detector's lifetime (failures become counters, never exceptions or logs).
+// size, bounding box, peak and second-moment shape, plus flags. BlobList is the
+// core BoundedList of blobs (storage allocated once at setup; the hot path only
+// overwrites it and counts what did not fit) plus the frame's image levels. DetectorCounters
+// accumulate over the detector's lifetime (failures become counters, never exceptions or logs).
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
-#include <vector>
+
+#include "core/bounded_list.h"
 
 namespace mocap::detect {
 
@@ -39,21 +40,12 @@ struct Blob {
   bool has(BlobFlag f) const noexcept { return (flags & f) != 0; }
 };
 
-// Fixed-capacity list of blobs; capacity chosen at setup, never grows in the hot path.
-class BlobList {
+// The blobs of one frame: a BoundedList (capacity chosen at setup, never grows in the
+// hot path) that also carries the image levels the detector used for the frame.
+class BlobList : public BoundedList<Blob> {
  public:
-  BlobList() = default;
-  explicit BlobList(std::size_t capacity) : storage_(capacity) {}
+  using BoundedList<Blob>::BoundedList;
 
-  std::size_t size() const noexcept { return size_; }
-  std::size_t capacity() const noexcept { return storage_.size(); }
-  bool empty() const noexcept { return size_ == 0; }
-  const Blob& operator[](std::size_t i) const noexcept { return storage_[i]; }
-  Blob& operator[](std::size_t i) noexcept { return storage_[i]; }
-  const Blob* begin() const noexcept { return storage_.data(); }
-  const Blob* end() const noexcept { return storage_.data() + size_; }
-
-  void clear() noexcept { size_ = 0; }
   // The image levels the detector used for this list's frame (background and noise
   // sigma estimate, threshold; DN). Consumers judging blob shapes (track/marker_shape.h)
   // read them here, on the thread that owns the list, not from the detector's counters.
@@ -64,16 +56,8 @@ class BlobList {
   };
   void set_levels(const Levels& levels) noexcept { levels_ = levels; }
   const Levels& levels() const noexcept { return levels_; }
-  // Appends when there is room; returns false (nothing written) when full.
-  bool push(const Blob& b) noexcept {
-    if (size_ >= storage_.size()) return false;
-    storage_[size_++] = b;
-    return true;
-  }
 
  private:
-  std::vector<Blob> storage_;
-  std::size_t size_ = 0;
   Levels levels_{};
 };
 

@@ -237,7 +237,7 @@ void BlobDetector::measure(const ImageView& img, BlobList& out) noexcept {
       b.flags |= kBlobTouchesBorder;
     }
     if (b.peak_dn >= maxval) b.flags |= kBlobSaturated;
-    if (!out.push(b)) ++counters_.blobs_dropped;
+    if (!out.push_back(b)) ++counters_.blobs_dropped;
   };
   for (int k = 0; k < n_comps_; ++k) {
     const CompAcc& c = comps_[k];

@@ -1,11 +1,13 @@
+// Design: see frame_points.h.
 #include "discover/frame_points.h"
 
 #include <array>
 #include <optional>
+#include <span>
+#include <vector>
 
-#include "detect/blob_detector.h"
 #include "formats/recording.h"
-#include "stereo/stereo_triangulator.h"
+#include "track/frame_processor.h"
 
 namespace mocap::discover {
 
@@ -14,35 +16,24 @@ Expected<PointSequence> triangulate_recording(const std::string& recording_dir,
   auto rec = Recording::open(recording_dir);
   if (!rec) return rec.error();
   const Rig& rig = rec->rig();
-  if (rig.cameras.size() < 2)
+  if (rig.cameras.size() < static_cast<std::size_t>(kMinCameras))
     return Error{recording_dir + "/rig.yaml: discover needs two cameras, the rig has " +
                  std::to_string(rig.cameras.size())};
-  // The tracker's detector settings (src/track TrackerConfig): round blobs only.
-  detect::DetectorConfig dcfg;
-  dcfg.max_elongation = 1.3;
-  std::array<std::optional<detect::BlobDetector>, 2> detectors;
-  std::array<detect::BlobList, 2> blobs;
-  for (std::size_t c = 0; c < 2; ++c) {
-    auto d = detect::BlobDetector::create(dcfg, rig.cameras[c].width, rig.cameras[c].height);
-    if (!d)
-      return Error{recording_dir + ": detection (" + rig.cameras[c].name +
-                   "): " + d.error().message};
-    detectors[c].emplace(std::move(d).value());
-    blobs[c] = detectors[c]->make_blob_list();
-  }
-  StereoConfig scfg;
-  auto stereo = StereoTriangulator::create(rig, scfg, 0, 1);
-  if (!stereo) return Error{recording_dir + "/rig.yaml: stereo: " + stereo.error().message};
-  PointList points(scfg.max_candidates);
-  std::array<std::vector<Vec2>, 2> px;
-  for (auto& v : px) v.resize(static_cast<std::size_t>(scfg.max_points_per_camera));
+  // The tracker's own stages (default TrackerConfig: round blobs only) over every camera
+  // of the rig, without targets: nothing is identified, the 3D points are the result.
+  auto proc = FrameProcessor::create(rig, TargetSet{}, nullptr, TrackerConfig{});
+  if (!proc) return Error{recording_dir + "/rig.yaml: " + proc.error().message};
+  FrameOutput out = proc->make_output();
+  const std::size_t n_cams = rig.cameras.size();
 
   constexpr std::uint32_t kSuspect = detect::kBlobTouchesBorder | detect::kBlobMerged |
                                      detect::kBlobSplit | detect::kBlobTruncated;
   PointSequence seq;
   std::optional<Error> first_error;
-  std::size_t loaded_frames = 0;
-  std::array<Image, 2> images;
+  std::size_t usable_frames = 0;
+  std::vector<Image> images(n_cams);
+  std::array<ImageView, kMaxCameras> image_views{};
+  std::array<const ImageView*, kMaxCameras> views{};
   const auto& frames = rec->frames();
   seq.frames.reserve(frames.size());
   for (std::size_t fi = 0; fi < frames.size(); ++fi) {
@@ -50,40 +41,35 @@ Expected<PointSequence> triangulate_recording(const std::string& recording_dir,
     FramePoints fp;
     fp.frame = fe.frame;
     fp.timestamp_ns = fe.timestamp_ns;
-    bool both = true;
-    for (std::size_t c = 0; c < 2; ++c) {
+    std::size_t present = 0;
+    for (std::size_t c = 0; c < n_cams; ++c) {
+      views[c] = nullptr;
       auto loaded = rec->load_frame(static_cast<int>(c), fe.frame, images[c]);
-      blobs[c].clear();
       if (!loaded) {  // a damaged frame is skipped (as in `mocap calibrate`), and reported
         if (!first_error) first_error = loaded.error();
-        if (cb.warn)
-          cb.warn(loaded.error().message + " (frame " + std::to_string(fe.frame) + " skipped)");
-        both = false;
+        if (cb.warn) {
+          cb.warn(loaded.error().message + " (frame " + std::to_string(fe.frame) + ", camera " +
+                  rig.cameras[c].name + " skipped)");
+        }
         continue;
       }
-      if (*loaded != FrameLoad::kOk) {
-        both = false;
-        continue;
-      }
-      detectors[c]->detect(images[c].view(), blobs[c]);
+      if (*loaded != FrameLoad::kOk) continue;
+      image_views[c] = images[c].view();
+      views[c] = &image_views[c];
+      ++present;
     }
-    if (both) ++loaded_frames;
-    if (!both) {
-      ++seq.frames_missing_camera;
-    } else {
-      std::array<int, 2> n{};
-      for (std::size_t c = 0; c < 2; ++c) {
-        const std::size_t count = std::min(blobs[c].size(), px[c].size());
-        for (std::size_t i = 0; i < count; ++i) px[c][i] = Vec2(blobs[c][i].x_px, blobs[c][i].y_px);
-        n[c] = static_cast<int>(count);
-      }
-      stereo->process(px[0].data(), n[0], px[1].data(), n[1], points);
-      for (const Point3& p : points) {
+    if (present < n_cams) ++seq.frames_missing_camera;
+    if (present >= static_cast<std::size_t>(kMinCameras)) {  // two cameras triangulate
+      ++usable_frames;
+      proc->process(std::span<const ImageView* const>(views.data(), n_cams), fe.timestamp_ns, out);
+      for (const Point3& p : out.points) {
         bool keep = !p.ambiguous;
-        for (std::size_t c = 0; c < 2 && keep; ++c) {
+        for (std::size_t c = 0; c < n_cams && keep; ++c) {
           const int b = p.blob_index[c];
-          keep = b >= 0 && static_cast<std::size_t>(b) < blobs[c].size() &&
-                 (blobs[c][static_cast<std::size_t>(b)].flags & kSuspect) == 0U;
+          if (b < 0) continue;  // a camera that did not see the point
+          const detect::BlobList& blobs = out.blobs[c];
+          keep = static_cast<std::size_t>(b) < blobs.size() &&
+                 (blobs[static_cast<std::size_t>(b)].flags & kSuspect) == 0U;
         }
         if (keep)
           fp.X_world_mm.push_back(p.X_world);
@@ -95,7 +81,7 @@ Expected<PointSequence> triangulate_recording(const std::string& recording_dir,
     if (cb.progress)
       cb.progress(static_cast<std::int64_t>(fi + 1), static_cast<std::int64_t>(frames.size()));
   }
-  if (loaded_frames == 0 && first_error) return *first_error;
+  if (usable_frames == 0 && first_error) return *first_error;
   return seq;
 }
 

@@ -1,10 +1,12 @@
 // Design: step 1a of `mocap discover`: every frame of a recording through the tracker's
-// own detection (src/detect, one detector per camera of the stereo pair) and stereo
-// correspondence + optimal triangulation (src/stereo), without identification (there
-// are no targets yet). Only points that can be trusted as one whole marker are kept:
-// candidates that share a blob with another (epipolar ambiguity) and points from
-// blobs flagged merged, split, truncated or touching the border are left out (counted),
-// so that the rigidity tests see unbiased points.
+// own stages (track/frame_processor.h, default TrackerConfig) over every camera of the
+// rig (2..kMaxCameras): detection, pairwise correspondence + optimal triangulation and,
+// for three or more cameras, the N-view merge; without targets (there are none yet), so
+// nothing is identified. A frame in which a camera is missing still gives the points of
+// the others when two or more remain (a stereo pair: none). Only points that can be trusted as one
+// whole marker are kept: candidates that share a blob with another (epipolar ambiguity) and points
+// from blobs flagged merged, split, truncated or touching the border are left out (counted), so
+// that the rigidity tests see unbiased points.
 #pragma once
 
 #include <cstdint>

@@ -10,12 +10,11 @@
 #include <vector>
 
 #include "core/expected.h"
+#include "core/joint_type.h"
 #include "core/types.h"
 #include "formats/targets_yaml.h"
 
 namespace mocap {
-
-enum class JointType { kBall, kHinge };
 
 const char* joint_type_name(JointType t) noexcept;  // "ball" | "hinge"
 

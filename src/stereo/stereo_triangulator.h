@@ -58,6 +58,28 @@ struct StereoCounters {
   std::uint64_t ambiguous = 0;                      // emitted candidates flagged ambiguous
   std::uint64_t candidate_overflow = 0;             // accepted but dropped: output full
   std::uint64_t bad_input = 0;                      // null pointer with n > 0 or n < 0
+
+  // Adds the counters of another camera pair of the same rig (the rig's total over its
+  // pairs): every count is summed, except `frames`, the larger of the two (the pairs
+  // see the same frames; a frame is not counted once per pair).
+  StereoCounters& operator+=(const StereoCounters& o) noexcept {
+    frames = frames > o.frames ? frames : o.frames;
+    for (std::size_t i = 0; i < 2; ++i) {
+      points_in[i] += o.points_in[i];
+      points_overflow[i] += o.points_overflow[i];
+      undistort_failed[i] += o.undistort_failed[i];
+    }
+    pairs_in_tolerance += o.pairs_in_tolerance;
+    rejected_degenerate += o.rejected_degenerate;
+    rejected_cheirality += o.rejected_cheirality;
+    rejected_depth += o.rejected_depth;
+    rejected_reproj += o.rejected_reproj;
+    candidates += o.candidates;
+    ambiguous += o.ambiguous;
+    candidate_overflow += o.candidate_overflow;
+    bad_input += o.bad_input;
+    return *this;
+  }
 };
 
 class StereoTriangulator {

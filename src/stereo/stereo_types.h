@@ -4,14 +4,14 @@
 // identification stage knows which candidates are mutually exclusive (they share a
 // blob in some camera). Candidates whose blob is shared with another candidate are
 // flagged `ambiguous`; the stereo stage never silently picks one of them.
-// PointList is a fixed-capacity output buffer: capacity is set once at setup, the hot
+// PointList is the core BoundedList of candidates: capacity set once at setup, the hot
 // path only clears and appends (push_back returns false when full, never allocates).
 #pragma once
 
 #include <array>
 #include <cstdint>
-#include <vector>
 
+#include "core/bounded_list.h"
 #include "core/camera_set.h"
 #include "core/types.h"
 
@@ -45,36 +45,7 @@ struct Point3 {
   bool reported = false;
 };
 
-class PointList {
- public:
-  PointList() = default;
-  explicit PointList(int capacity) { set_capacity(capacity); }
-
-  // Setup only (allocates).
-  void set_capacity(int capacity) {
-    points_.assign(static_cast<std::size_t>(capacity > 0 ? capacity : 0), Point3{});
-    size_ = 0;
-  }
-
-  void clear() noexcept { size_ = 0; }
-  bool push_back(const Point3& p) noexcept {
-    if (size_ >= capacity()) return false;
-    points_[static_cast<std::size_t>(size_++)] = p;
-    return true;
-  }
-  int size() const noexcept { return size_; }
-  bool empty() const noexcept { return size_ == 0; }
-  int capacity() const noexcept { return static_cast<int>(points_.size()); }
-  Point3& operator[](int i) noexcept { return points_[static_cast<std::size_t>(i)]; }
-  const Point3& operator[](int i) const noexcept { return points_[static_cast<std::size_t>(i)]; }
-  Point3* begin() noexcept { return points_.data(); }
-  Point3* end() noexcept { return points_.data() + size_; }
-  const Point3* begin() const noexcept { return points_.data(); }
-  const Point3* end() const noexcept { return points_.data() + size_; }
-
- private:
-  std::vector<Point3> points_;
-  int size_ = 0;
-};
+// Candidates of one frame, indexed by int (the indices travel in int fields).
+using PointList = BoundedList<Point3, int>;
 
 }  // namespace mocap

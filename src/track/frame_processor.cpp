@@ -168,30 +168,9 @@ void FrameProcessor::triangulate(FrameOutput& out) noexcept {
     lists[listed++] = &pair_points_[k];
   }
   merger_.process(px, n, lists, listed, out.points);
-  sum_stereo_counters();
-}
-
-void FrameProcessor::sum_stereo_counters() noexcept {
-  StereoCounters t;
-  for (const StereoTriangulator& st : pairs_) {
-    const StereoCounters& c = st.counters();
-    t.frames = std::max(t.frames, c.frames);
-    for (std::size_t i = 0; i < 2; ++i) {
-      t.points_in[i] += c.points_in[i];
-      t.points_overflow[i] += c.points_overflow[i];
-      t.undistort_failed[i] += c.undistort_failed[i];
-    }
-    t.pairs_in_tolerance += c.pairs_in_tolerance;
-    t.rejected_degenerate += c.rejected_degenerate;
-    t.rejected_cheirality += c.rejected_cheirality;
-    t.rejected_depth += c.rejected_depth;
-    t.rejected_reproj += c.rejected_reproj;
-    t.candidates += c.candidates;
-    t.ambiguous += c.ambiguous;
-    t.candidate_overflow += c.candidate_overflow;
-    t.bad_input += c.bad_input;
-  }
-  stereo_total_ = t;
+  StereoCounters total;
+  for (const StereoTriangulator& st : pairs_) total += st.counters();
+  stereo_total_ = total;
 }
 
 void FrameProcessor::measure_points(FrameOutput& out) noexcept {

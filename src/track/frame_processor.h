@@ -145,7 +145,6 @@ class FrameProcessor {
   void triangulate(FrameOutput& out) noexcept;
   // Marks the identification's input; drops unfit views of points seen by 3+ cameras.
   void measure_points(FrameOutput& out) noexcept;
-  void sum_stereo_counters() noexcept;
   // Chain tracking after identification: chain-solved bodies join out.poses.
   void track_chain(int n_points, std::int64_t timestamp_ns, FrameOutput& out) noexcept;
   // False when the blob of a marker at X_world does not look like a whole marker.

@@ -4,59 +4,91 @@
 
 namespace mocap {
 
-std::vector<std::pair<std::string, std::uint64_t>> collect_counters(const FrameProcessor& p) {
-  std::vector<std::pair<std::string, std::uint64_t>> c;
+namespace {
+
+using Counters = std::vector<std::pair<std::string, std::uint64_t>>;
+
+// One stats.json key of a counter struct: the key without its prefix and the member.
+template <class S>
+struct StatsField {
+  const char* key;
+  std::uint64_t S::*member;
+};
+
+// The counters of stats.json (keys are public: ../shared/spec/interfaces.md), in output
+// order; a new counter costs one line here.
+constexpr StatsField<detect::DetectorCounters> kDetectFields[] = {
+    {"frames", &detect::DetectorCounters::frames},
+    {"frames_invalid", &detect::DetectorCounters::frames_invalid},
+    {"frames_overflow", &detect::DetectorCounters::frames_overflow},
+    {"blobs_dropped", &detect::DetectorCounters::blobs_dropped},
+    {"rejected_small", &detect::DetectorCounters::rejected_small},
+    {"rejected_large", &detect::DetectorCounters::rejected_large},
+    {"rejected_elongated", &detect::DetectorCounters::rejected_elongated},
+    {"merged", &detect::DetectorCounters::merged},
+    {"splits", &detect::DetectorCounters::splits},
+};
+constexpr StatsField<StereoCounters> kStereoFields[] = {
+    {"frames", &StereoCounters::frames},
+    {"candidates", &StereoCounters::candidates},
+    {"ambiguous", &StereoCounters::ambiguous},
+    {"rejected_reproj", &StereoCounters::rejected_reproj},
+    {"candidate_overflow", &StereoCounters::candidate_overflow},
+};
+constexpr StatsField<MultiViewCounters> kMultiViewFields[] = {
+    {"views_added", &MultiViewCounters::views_added},
+    {"views_dropped", &MultiViewCounters::views_dropped},
+    {"merged", &MultiViewCounters::merged},
+    {"unfit_views", &MultiViewCounters::unfit_views},
+    {"unfit_pairings", &MultiViewCounters::unfit_pairings},
+    {"ghosts_rejected", &MultiViewCounters::ghosts_rejected},
+    {"ambiguous", &MultiViewCounters::ambiguous},
+    {"hypothesis_overflow", &MultiViewCounters::hypothesis_overflow},
+    {"point_overflow", &MultiViewCounters::point_overflow},
+    {"shared_views_split", &MultiViewCounters::shared_views_split},
+};
+constexpr StatsField<IdentifyCounters> kIdentifyFields[] = {
+    {"bodies_found", &IdentifyCounters::bodies_found},
+    {"full_searches", &IdentifyCounters::full_searches},
+    {"warm_accepted", &IdentifyCounters::warm_accepted},
+    {"warm_fallbacks", &IdentifyCounters::warm_fallbacks},
+    {"velocity_rejects", &IdentifyCounters::velocity_rejects},
+    {"jump_reboots", &IdentifyCounters::jump_reboots},
+    {"point_overflow", &IdentifyCounters::point_overflow},
+    {"node_limit_hits", &IdentifyCounters::node_limit_hits},
+};
+constexpr StatsField<ChainCounters> kChainFields[] = {
+    {"attempts", &ChainCounters::attempts},
+    {"joints_solved", &ChainCounters::joints_solved},
+    {"too_few_labels", &ChainCounters::too_few_labels},
+    {"ambiguous_labels", &ChainCounters::ambiguous_labels},
+    {"chi2_drops", &ChainCounters::chi2_drops},
+    {"chi2_rejects", &ChainCounters::chi2_rejects},
+    {"uncertain_rejects", &ChainCounters::uncertain_rejects},
+    {"node_limit_hits", &ChainCounters::node_limit_hits},
+};
+
+template <class S, std::size_t N>
+void add_fields(Counters& out, const std::string& prefix, const S& counters,
+                const StatsField<S> (&fields)[N]) {
+  for (const StatsField<S>& f : fields) out.emplace_back(prefix + f.key, counters.*f.member);
+}
+
+}  // namespace
+
+Counters collect_counters(const FrameProcessor& p) {
+  Counters c;
   for (int cam = 0; cam < p.camera_count(); ++cam) {
-    const detect::DetectorCounters& d = p.detector_counters(cam);
-    const std::string k = "detect_cam" + std::to_string(cam) + "_";
-    c.emplace_back(k + "frames", d.frames);
-    c.emplace_back(k + "frames_invalid", d.frames_invalid);
-    c.emplace_back(k + "frames_overflow", d.frames_overflow);
-    c.emplace_back(k + "blobs_dropped", d.blobs_dropped);
-    c.emplace_back(k + "rejected_small", d.rejected_small);
-    c.emplace_back(k + "rejected_large", d.rejected_large);
-    c.emplace_back(k + "rejected_elongated", d.rejected_elongated);
-    c.emplace_back(k + "merged", d.merged);
-    c.emplace_back(k + "splits", d.splits);
+    add_fields(c, "detect_cam" + std::to_string(cam) + "_", p.detector_counters(cam),
+               kDetectFields);
   }
   const StereoCounters& s = p.stereo_counters();
-  c.emplace_back("stereo_frames", s.frames);
-  c.emplace_back("stereo_candidates", s.candidates);
-  c.emplace_back("stereo_ambiguous", s.ambiguous);
-  c.emplace_back("stereo_rejected_reproj", s.rejected_reproj);
-  c.emplace_back("stereo_candidate_overflow", s.candidate_overflow);
+  add_fields(c, "stereo_", s, kStereoFields);
   c.emplace_back("stereo_points_overflow", s.points_overflow[0] + s.points_overflow[1]);
-  if (p.camera_count() > 2) {
-    const MultiViewCounters& m = p.multiview_counters();
-    c.emplace_back("multiview_views_added", m.views_added);
-    c.emplace_back("multiview_views_dropped", m.views_dropped);
-    c.emplace_back("multiview_merged", m.merged);
-    c.emplace_back("multiview_unfit_views", m.unfit_views);
-    c.emplace_back("multiview_unfit_pairings", m.unfit_pairings);
-    c.emplace_back("multiview_ghosts_rejected", m.ghosts_rejected);
-    c.emplace_back("multiview_ambiguous", m.ambiguous);
-    c.emplace_back("multiview_hypothesis_overflow", m.hypothesis_overflow);
-    c.emplace_back("multiview_point_overflow", m.point_overflow);
-    c.emplace_back("multiview_shared_views_split", m.shared_views_split);
-  }
-  const IdentifyCounters& i = p.identify_counters();
-  c.emplace_back("identify_bodies_found", i.bodies_found);
-  c.emplace_back("identify_full_searches", i.full_searches);
-  c.emplace_back("identify_warm_accepted", i.warm_accepted);
-  c.emplace_back("identify_warm_fallbacks", i.warm_fallbacks);
-  c.emplace_back("identify_velocity_rejects", i.velocity_rejects);
-  c.emplace_back("identify_jump_reboots", i.jump_reboots);
-  c.emplace_back("identify_point_overflow", i.point_overflow);
-  c.emplace_back("identify_node_limit_hits", i.node_limit_hits);
+  if (p.camera_count() > 2) add_fields(c, "multiview_", p.multiview_counters(), kMultiViewFields);
+  add_fields(c, "identify_", p.identify_counters(), kIdentifyFields);
   if (const ChainCounters* k = p.chain_counters()) {
-    c.emplace_back("chain_attempts", k->attempts);
-    c.emplace_back("chain_joints_solved", k->joints_solved);
-    c.emplace_back("chain_too_few_labels", k->too_few_labels);
-    c.emplace_back("chain_ambiguous_labels", k->ambiguous_labels);
-    c.emplace_back("chain_chi2_drops", k->chi2_drops);
-    c.emplace_back("chain_chi2_rejects", k->chi2_rejects);
-    c.emplace_back("chain_uncertain_rejects", k->uncertain_rejects);
-    c.emplace_back("chain_node_limit_hits", k->node_limit_hits);
+    add_fields(c, "chain_", *k, kChainFields);
     for (std::size_t j = 0; j < p.model().joints.size() && j < k->joint_poses.size(); ++j) {
       const std::string key = "coverage_" + p.model().joints[j].name + "_";
       c.emplace_back(key + "poses", k->joint_poses[j]);

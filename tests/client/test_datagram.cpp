@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <random>
+#include <type_traits>
 #include <vector>
 
 #include "client/crc32.h"
@@ -102,6 +103,15 @@ TEST(Datagram, SpecByteLayoutOfOneJointMessage) {
   EXPECT_EQ(bytes[73], (c >> 8) & 0xFFu);
   EXPECT_EQ(bytes[74], (c >> 16) & 0xFFu);
   EXPECT_EQ(bytes[75], c >> 24);
+}
+
+// One joint type for the project and the message (core/joint_type.h), with the spec's
+// wire values.
+TEST(Datagram, JointKindIsTheProjectsJointTypeWithTheWireValues) {
+  static_assert(std::is_same_v<JointKind, mocap::JointType>);
+  static_assert(sizeof(JointKind) == 1);
+  EXPECT_EQ(static_cast<int>(JointKind::kBall), 0);
+  EXPECT_EQ(static_cast<int>(JointKind::kHinge), 1);
 }
 
 TEST(Datagram, RoundTripForEveryJointCount) {

@@ -4,18 +4,21 @@
 //  - the short-term tracks never jump from one true marker to another;
 //  - every body with all but at most one of its markers, no marker in a wrong body,
 //    the topology and joint types, ball centres within 0.5 mm and hinge axes within
-//    0.3 deg in world terms (discover_truth.h), with and without the tracker's poses.
+//    0.3 deg in world terms (discover_truth.h), with and without the tracker's poses;
+//  - on a 4-camera rig, every camera takes part (frames without camera 1 still give points).
 // The command line and the angles of `mocap run` with the result: test_walkthrough.cpp.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <map>
 
 #include "discover/frame_points.h"
 #include "discover/point_tracker.h"
 #include "discover_truth.h"
 #include "formats/csv_outputs.h"
+#include "formats/recording.h"
 #include "tests/support/test_support.h"
 #include "track/truth.h"
 
@@ -97,6 +100,42 @@ TEST(DiscoverSim, SimulatedRecordingAgainstTruth) {
 
   // The command line, `mocap run` with the result and the angles against the truth:
   // test_walkthrough.cpp.
+}
+
+// A 4-camera rig: every camera takes part, not only the pair (0, 1). Camera 1's images
+// are removed from every other frame: those frames still give points from cameras 0, 2
+// and 3 (a stereo pair (0, 1) would give none), and every point lies on a true marker.
+// A few frames only (CI has 2 cores).
+TEST(DiscoverSim, FourCameraRecordingUsesEveryCamera) {
+  test::TempDir dir("discover_4cam");
+  const std::string rec = dir.file("rec");
+  constexpr int kFrames = 8;
+  auto sim = run_mocap(
+      "simulate --cameras 4 --frames " + std::to_string(kFrames) + " --seed 3 --out " + rec, 300);
+  ASSERT_EQ(sim.exit_code, 0) << sim.output;
+  for (int f = 0; f < kFrames; f += 2)
+    ASSERT_TRUE(std::filesystem::remove(frame_file_path(rec, "cam1", f)));
+
+  auto points = discover::triangulate_recording(rec);
+  ASSERT_TRUE(points) << points.error().message;
+  ASSERT_EQ(points->frames.size(), static_cast<std::size_t>(kFrames));
+  EXPECT_EQ(points->frames_missing_camera, kFrames / 2);
+  auto gt = read_gt_markers_csv(rec + "/gt/markers.csv");
+  ASSERT_TRUE(gt) << gt.error().message;
+  int without_cam1 = 0, off_marker = 0;
+  for (const discover::FramePoints& fp : points->frames) {
+    for (const Vec3& X : fp.X_world_mm) {
+      double nearest = 1e9;
+      for (const GtMarker& m : *gt)
+        if (m.frame == fp.frame) nearest = std::min(nearest, (m.X_world - X).norm());
+      off_marker += nearest > 1.0 ? 1 : 0;
+    }
+    if (fp.frame % 2 == 0) without_cam1 += static_cast<int>(fp.X_world_mm.size());
+  }
+  // Only trusted points are kept (no ambiguous candidate, no view from a flagged blob):
+  // on this arc a few per frame; a pair (0, 1) alone would give none at all.
+  EXPECT_GE(without_cam1, kFrames / 2);
+  EXPECT_EQ(off_marker, 0);
 }
 
 // Fewer frames than needed, and no motion at all: one-line errors naming the recording.

@@ -126,7 +126,7 @@ TEST(FrameResultBuilder, BlobsSayWhatTheyBecame) {
       b.x_px = 100.0 + 10.0 * i;
       b.y_px = 50.0 + c;
       b.area_px = static_cast<float>(M_PI * 25.0);  // a disc of 10 px diameter
-      ASSERT_TRUE(out->blobs[static_cast<std::size_t>(c)].push(b));
+      ASSERT_TRUE(out->blobs[static_cast<std::size_t>(c)].push_back(b));
     }
   }
   Point3 p;

@@ -1,15 +1,15 @@
 // Design: the mapping of the run configuration onto the pipeline and the HAL: stage
 // names and overrides, command-line overrides, a sim setup built end to end from a
 // configuration (cameras configured as asked, buffers sized from the ring depth), and
-// the stalling camera of fault injection (N frames, then timeouts only).
+// fault_injection.stall_after_frames: camera 0 in a hal::FaultCamera (N frames, then
+// timeouts only).
 #include "pipeline/service/live_setup.h"
 
 #include <gtest/gtest.h>
 
 #include <string>
 
-#include "hal/replay_camera.h"
-#include "pipeline/service/stalling_camera.h"
+#include "hal/fault_camera.h"
 #include "tests/service/tiny_recording.h"
 #include "tests/support/test_support.h"
 
@@ -175,29 +175,30 @@ TEST(LiveSetup, HardwareWithoutRigIsAConfigurationError) {
   EXPECT_EQ(no_rig.error().message, "mocap run: rig: required by the v4l2 backend");
 }
 
-TEST(StallingCamera, DeliversNFramesThenTimesOut) {
+TEST(LiveSetup, StallAfterFramesWrapsCameraZeroInAFaultCamera) {
   test::TempDir dir("svc_stallcam");
-  test::write_tiny_recording(dir.path(), 8);
-  auto rec = Recording::open(dir.path());
-  ASSERT_TRUE(rec) << rec.error().message;
-  auto shared = std::make_shared<const Recording>(std::move(rec).value());
-  auto inner = hal::ReplayCamera::open(shared, 0, hal::ReplayPacing::kAsFastAsPossible);
-  ASSERT_TRUE(inner);
-  hal::CameraConfig native = (*inner)->native_config();
-  native.trigger = hal::TriggerMode::kSoftware;
-  StallingCamera cam(std::move(inner).value(), 3);
-  ASSERT_TRUE(cam.configure(native));
-  ASSERT_TRUE(cam.start());
-  EXPECT_NE(cam.notice().find("stalls after 3 frames"), std::string::npos) << cam.notice();
+  test::write_tiny_recording(dir.file("rec"), 8);
+  test::write_file(dir.file("m.yaml"), test::tiny_replay_config(dir.file("rec"), ""));
+  auto cfg = config::load_run_config(dir.file("m.yaml"));
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  cfg->faults.stall_after_frames = 3;
+  auto setup = LiveSetup::create(*cfg, nullptr);
+  ASSERT_TRUE(setup) << setup.error().message;
+  const auto cams = (*setup)->cameras();
+  auto* cam = dynamic_cast<hal::FaultCamera*>(cams[0]);
+  ASSERT_NE(cam, nullptr);
+  EXPECT_EQ(dynamic_cast<hal::FaultCamera*>(cams[1]), nullptr);  // camera 0 only
+  EXPECT_EQ(cam->config().trigger, hal::TriggerMode::kSoftware);
+  ASSERT_TRUE(cam->start());
   int delivered = 0, timeouts = 0;
   for (int i = 0; i < 6; ++i) {
-    ASSERT_EQ(cam.trigger(), hal::CameraStatus::kOk);
+    ASSERT_EQ(cam->trigger(), hal::CameraStatus::kOk);
     hal::Frame f;
-    const hal::CameraStatus st = cam.dequeue(f, 50);
+    const hal::CameraStatus st = cam->dequeue(f, 20);
     if (st == hal::CameraStatus::kOk) {
       ++delivered;
       EXPECT_EQ(f.sequence, static_cast<std::uint64_t>(i));
-      EXPECT_EQ(cam.release(f), hal::CameraStatus::kOk);
+      EXPECT_EQ(cam->release(f), hal::CameraStatus::kOk);
     } else {
       EXPECT_EQ(st, hal::CameraStatus::kTimeout);
       ++timeouts;
@@ -205,9 +206,10 @@ TEST(StallingCamera, DeliversNFramesThenTimesOut) {
   }
   EXPECT_EQ(delivered, 3);
   EXPECT_EQ(timeouts, 3);
-  EXPECT_EQ(cam.counters().frames.get(), 3u);
-  cam.stop();
-  EXPECT_EQ(cam.state(), hal::CameraState::kConfigured);
+  EXPECT_EQ(cam->injected(hal::Fault::kStall), 3u);
+  EXPECT_EQ(cam->counters().frames.get(), 3u);  // the inner camera was not asked again
+  cam->stop();
+  EXPECT_EQ(cam->state(), hal::CameraState::kConfigured);
 }
 
 }  // namespace
