@@ -27,7 +27,7 @@ for t in "${targets[@]}"; do
     exit 2
   fi
 done
-command -v clang++ >/dev/null || { echo "fuzz.sh: clang++ not found (deploy/install-deps.sh installs it)" >&2; exit 2; }
+command -v clang++ >/dev/null || { echo "fuzz.sh: clang++ not found (bash deploy/install-deps.sh installs it; --for test does not)" >&2; exit 2; }
 
 build="${MOCAP_FUZZ_BUILD:-$root/build-fuzz}"
 jobs="${MOCAP_FUZZ_JOBS:-1}"

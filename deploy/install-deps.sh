@@ -1,12 +1,27 @@
 #!/usr/bin/env bash
 # Installs every build, test and run dependency of the mocap tracker from Debian 12's
 # packages. Idempotent: packages already present are skipped, so a second run is quick.
-# Usage (as root, or with sudo available):  bash deploy/install-deps.sh
+# Usage (as root, or with sudo available):  bash deploy/install-deps.sh [--for test]
+#   --for test: only what building and running the test suite needs (deploy/test.sh):
+#   leaves out the tools used elsewhere only: clang and its runtime (deploy/fuzz.sh),
+#   gnuplot (bench/evaluation's plots) and OpenCV (the bench/ baseline), which together
+#   are about a fifth of the packages and most of the download.
 set -euo pipefail
+
+profile=all
+case "${1:-}" in
+  "") ;;
+  --for)
+    case "${2:-}" in
+      test) profile=test ;;
+      *) echo "install-deps.sh: --for takes 'test', got '${2:-}'" >&2; exit 2 ;;
+    esac ;;
+  *) echo "install-deps.sh: unknown argument '$1' (usage: install-deps.sh [--for test])" >&2; exit 2 ;;
+esac
 
 packages=(
   # toolchain
-  build-essential cmake ninja-build pkg-config git clang libclang-rt-14-dev clang-format
+  build-essential cmake ninja-build pkg-config git clang-format
   # core libraries
   libeigen3-dev libceres-dev libyaml-cpp-dev libcli11-dev
   # tests and benchmarks
@@ -19,14 +34,22 @@ packages=(
   libsystemd-dev systemd liburdfdom-tools python3
   # header-only baseline of the ring-buffer benchmark
   libboost-dev
-  # CRC-32 reference of the client tests, and the plots of the evaluation script
-  zlib1g-dev gnuplot-nox
+  # CRC-32 reference of the client tests
+  zlib1g-dev
   # ecosystem outputs: ROS 2 over DDS (Cyclone DDS C API + idlc), the Foxglove WebSocket
   # server (Boost.Beast from libboost-dev, nlohmann-json)
   cyclonedds-dev cyclonedds-tools nlohmann-json3-dev
-  # the OpenCV comparison baseline of bench/ (never linked by the product)
-  libopencv-dev
 )
+if [ "$profile" = all ]; then
+  packages+=(
+    # libFuzzer builds of deploy/fuzz.sh
+    clang libclang-rt-14-dev
+    # the plots of the evaluation script (bench/evaluation)
+    gnuplot-nox
+    # the OpenCV comparison baseline of bench/ (never linked by the product)
+    libopencv-dev
+  )
+fi
 
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then

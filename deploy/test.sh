@@ -15,7 +15,11 @@
 #   MOCAP_TEST_SKIP_SANITIZERS=1 bash deploy/test.sh  only the optimised build and its tests
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
-bash deploy/install-deps.sh
+if [ "${MOCAP_TEST_OPTIMISED:-0}" = "1" ] || [ "${MOCAP_TEST_SKIP_SANITIZERS:-0}" = "1" ]; then
+  bash deploy/install-deps.sh  # the optimised build includes bench/ (OpenCV baseline)
+else
+  bash deploy/install-deps.sh --for test
+fi
 
 jobs=$(nproc 2>/dev/null || echo 2)
 export CTEST_OUTPUT_ON_FAILURE=1

@@ -34,6 +34,8 @@ const char* to_string(Fault f) noexcept {
       return "replace_image";
     case Fault::kStall:
       return "stall";
+    case Fault::kSequenceOffset:
+      return "sequence_offset";
   }
   return "unknown";
 }
@@ -161,6 +163,9 @@ CameraStatus FaultCamera::apply(Frame& f, int timeout_ms) noexcept {
         break;
       case Fault::kReplaceImage:
         f.image = substitute_->view();
+        break;
+      case Fault::kSequenceOffset:
+        f.sequence += static_cast<std::uint64_t>(r->value);
         break;
       case Fault::kStall:  // held before the inner dequeue (stalled()); never a frame rule
         break;

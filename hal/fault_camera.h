@@ -12,6 +12,10 @@
 //   kTimestampJump           : `value` ns are added to the timestamp (a clock step)
 //   kReplaceImage            : the image is replaced by a substitute (e.g. an image full
 //                              of blobs that overflows the detector)
+//   kSequenceOffset          : `value` is added to the sequence number (a free-running
+//                              camera whose frame counter is its own, not the trigger's:
+//                              with count kForever its numbers never match another
+//                              camera's, and frames pair only by timestamp)
 //   kStall                   : a camera whose cable was pulled without the driver
 //                              noticing: once `first` good frames were delivered, the next
 //                              `count` dequeue calls (kForever: all of them) wait timeout_ms
@@ -48,8 +52,9 @@ enum class Fault : std::uint8_t {
   kTimestampJump,
   kReplaceImage,
   kStall,
+  kSequenceOffset,
 };
-inline constexpr std::size_t kFaultCount = 9;
+inline constexpr std::size_t kFaultCount = 10;
 const char* to_string(Fault f) noexcept;
 
 struct FaultRule {
@@ -57,7 +62,8 @@ struct FaultRule {
   Fault fault = Fault::kIoError;
   std::uint64_t first = 0;  // index of the first inner good frame affected
   std::uint64_t count = 1;  // consecutive frames affected (kStall: dequeue calls)
-  std::int64_t value = 0;   // kTruncatedFrame: rows kept; kTimestampJump: ns added
+  std::int64_t value = 0;   // kTruncatedFrame: rows kept; kTimestampJump: ns added;
+                            // kSequenceOffset: added to the sequence number
 };
 
 class FaultCamera final : public Camera {

@@ -116,6 +116,7 @@ void IdentifyStage::process(const hal::FramePair& set) noexcept {
   release_set(set);
   processor_.process_blobs(capture_ns, out);
   library_.stereo.publish(kStereoFields, processor_.stereo_counters());
+  if (cameras_ > 2) library_.multiview.publish(kMultiViewFields, processor_.multiview_counters());
   library_.identify.publish(kIdentifyFields, processor_.identify_counters());
   if (const ChainCounters* chain = processor_.chain_counters()) {
     library_.chain.publish(kChainFields, *chain);
@@ -158,6 +159,10 @@ void IdentifyStage::report(rt::CounterReport& out) const {
   counters_.group.report(cameras_, out);
   for (std::size_t i = 0; i < kStereoFields.size(); ++i)
     out.emplace_back(std::string("stereo_") + kStereoFields[i].name, library_.stereo.get(i));
+  for (std::size_t i = 0; cameras_ > 2 && i < kMultiViewFields.size(); ++i) {
+    out.emplace_back(std::string("multiview_") + kMultiViewFields[i].name,
+                     library_.multiview.get(i));
+  }
   for (std::size_t i = 0; i < kIdentifyFields.size(); ++i)
     out.emplace_back(std::string("identify_") + kIdentifyFields[i].name, library_.identify.get(i));
   if (!processor_.has_model()) return;

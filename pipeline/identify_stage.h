@@ -84,6 +84,7 @@ class IdentifyStage {
   } counters_;
   struct alignas(64) Library {
     StereoMirror stereo;
+    MultiViewMirror multiview;  // zero with two cameras
     IdentifyMirror identify;
     ChainMirror chain;        // zero without a model
     CoverageMirror coverage;  // per joint

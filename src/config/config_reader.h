@@ -59,4 +59,7 @@ class Section {
   std::string where_;
 };
 
+// Empty when `value` is a valid HOST:PORT, else the problem (run_config_checks.cpp).
+std::string host_port_problem(const std::string& value);
+
 }  // namespace mocap::config_detail

@@ -8,7 +8,6 @@
 
 #include <unistd.h>
 
-#include <cstdio>
 #include <filesystem>
 
 #include "config/config_reader.h"
@@ -23,78 +22,6 @@ using config_detail::Section;
 using formats_detail::fail;
 using formats_detail::index_path;
 using formats_detail::line_suffix;
-
-const char* to_string(CameraBackend b) noexcept {
-  switch (b) {
-    case CameraBackend::kSim:
-      return "sim";
-    case CameraBackend::kReplay:
-      return "replay";
-    case CameraBackend::kV4l2:
-      return "v4l2";
-    case CameraBackend::kLibcamera:
-      return "libcamera";
-  }
-  return "?";
-}
-
-const char* to_string(TriggerMode t) noexcept {
-  switch (t) {
-    case TriggerMode::kFreeRun:
-      return "free_run";
-    case TriggerMode::kExternal:
-      return "external";
-    case TriggerMode::kSoftware:
-      return "software";
-  }
-  return "?";
-}
-
-RunConfig default_run_config() { return RunConfig{}; }
-
-namespace {
-
-// Empty when `value` is a valid HOST:PORT, else the problem.
-std::string host_port_problem(const std::string& value) {
-  const std::size_t colon = value.rfind(':');
-  if (colon == std::string::npos || colon == 0 || colon + 1 == value.size())
-    return "expected HOST:PORT, got '" + value + "'";
-  int port = 0;
-  for (std::size_t i = colon + 1; i < value.size(); ++i) {
-    if (value[i] < '0' || value[i] > '9' || port > 65535) return "bad port in '" + value + "'";
-    port = port * 10 + (value[i] - '0');
-  }
-  if (port < 1 || port > 65535) return "port must be in 1..65535, got '" + value + "'";
-  return {};
-}
-
-}  // namespace
-
-Expected<void> check_trigger_rate_hz(const std::string& where, double hz) {
-  if (!(hz >= kMinTriggerRateHz && hz <= kMaxTriggerRateHz)) {
-    char buf[96];
-    std::snprintf(buf, sizeof buf, "must be in [%g, %g] Hz, got %g", kMinTriggerRateHz,
-                  kMaxTriggerRateHz, hz);
-    return make_error(where, "", buf);
-  }
-  return {};
-}
-
-Expected<void> check_loop_frames(const std::string& where, long long frames) {
-  if (frames < kMinLoopFrames || frames > kMaxLoopFrames) {
-    return make_error(where, "",
-                      "must be in " + std::to_string(kMinLoopFrames) + ".." +
-                          std::to_string(kMaxLoopFrames) + ", got " + std::to_string(frames));
-  }
-  return {};
-}
-
-Expected<void> check_host_port(const std::string& file, const std::string& where,
-                               const std::string& value) {
-  const std::string problem = host_port_problem(value);
-  if (!problem.empty()) return make_error(file, where, problem);
-  return {};
-}
 
 namespace {
 
@@ -289,7 +216,7 @@ void read_outputs(const std::string& file, const YAML::Node& node, OutputSetting
       for (std::size_t i = 0; i < list.size(); ++i) {
         const std::string where = index_path(s.path("udp"), i);
         const std::string v = formats_detail::get_string(list[i], where);
-        const std::string problem = host_port_problem(v);
+        const std::string problem = config_detail::host_port_problem(v);
         if (!problem.empty()) fail(where, problem + line_suffix(list[i]));
         o.udp.push_back(v);
       }

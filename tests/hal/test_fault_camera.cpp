@@ -1,6 +1,7 @@
 // hal::FaultCamera on a scripted inner camera (no rendering, no files): the stall
 // (kStall) holds the camera after N good frames without asking the inner camera, for a
-// number of calls or for ever, then resumes with the frames that piled up; the owning
+// number of calls or for ever, then resumes with the frames that piled up; a sequence
+// offset renumbers the frames of its rule only; the owning
 // wrap() keeps the inner camera alive; a stall costs no allocation. The other fault
 // kinds run through the live pipeline in tests/faults.
 #include <gtest/gtest.h>
@@ -76,6 +77,19 @@ TEST(FaultCamera, StallForSomeCallsThenResumesWithThePiledUpFrames) {
   EXPECT_EQ((*cam)->injected_total(), 3u);
   EXPECT_EQ((*cam)->frames_seen(), 4u);
   EXPECT_STREQ(to_string(Fault::kStall), "stall");
+}
+
+TEST(FaultCamera, SequenceOffsetRenumbersOnlyTheFramesOfItsRule) {
+  ScriptedCamera inner;
+  auto cam = FaultCamera::wrap(inner, {{Fault::kSequenceOffset, 2, 3, 1000}});
+  ASSERT_TRUE(cam) << cam.error().message;
+  ASSERT_TRUE((*cam)->configure(CameraConfig{}));
+  ASSERT_TRUE((*cam)->start());
+  std::vector<std::int64_t> got;
+  for (int i = 0; i < 6; ++i) got.push_back(trigger_and_take(**cam));
+  EXPECT_EQ(got, (std::vector<std::int64_t>{0, 1, 1002, 1003, 1004, 5}));
+  EXPECT_EQ((*cam)->injected(Fault::kSequenceOffset), 3u);
+  EXPECT_STREQ(to_string(Fault::kSequenceOffset), "sequence_offset");
 }
 
 TEST(FaultCamera, OwningWrapStallsForeverWithoutAllocating) {

@@ -190,6 +190,16 @@ void expect_stage_threads_do_not_allocate(SimRigFixture& rig, std::uint64_t fram
   test::wait_finished(**p);
   (*p)->stop();
   EXPECT_GT(sink.count(), frames / 2);
+  // The multi-view merger's counters are reported with three or more cameras only.
+  const PipelineStats st = (*p)->stats();
+  const bool has_multiview = std::any_of(st.counters.begin(), st.counters.end(), [](const auto& c) {
+    return c.first.rfind("multiview_", 0) == 0;
+  });
+  EXPECT_EQ(has_multiview, (*p)->camera_count() > 2);
+  if (has_multiview) {
+    EXPECT_EQ(counter(st, "multiview_frames"), counter(st, "identify_frames"));
+    EXPECT_GT(counter(st, "multiview_points"), 0u);
+  }
   std::vector<StageId> ids = {StageId::kCapture, StageId::kIdentify, StageId::kPublish};
   for (int c = 0; c < (*p)->camera_count(); ++c) ids.push_back(StageId::detect(c));
   for (StageId id : ids) {

@@ -1,7 +1,7 @@
 // Faults around the live pipeline (functional, never speed):
 //   * nobody listens on the UDP port (the consumer was killed): every frame is still
 //     processed and published, any send error is only counted;
-//   * one camera stalls for 300 ms: the other camera's frames keep being dequeued
+//   * one camera stalls for >= 300 ms: the other camera's frames keep being dequeued
 //     (capture does not wait on the stalled one), the stall shows in the stats
 //     (camera_max_silence_us_cam1, dequeue_timeouts_cam1) and in health() while it
 //     lasts, and the tracker publishes again afterwards;
@@ -12,7 +12,8 @@
 //     are counted per camera (timestamp_backwards/jumps), the identifier drops its prior
 //     on the steps back (identify_bad_timestamps), and the detector, stereo and
 //     identification counters reach the stats and health() unchanged.
-// The camera wrapper below is local to these tests (a stalled or offset sim camera).
+// Every fault comes from the one fault-injecting camera, hal::FaultCamera (kStall,
+// kSequenceOffset, kTimestampJump, kReplaceImage).
 #include <gtest/gtest.h>
 #include <sys/socket.h>
 #include <unistd.h>
@@ -33,50 +34,6 @@ namespace {
 using test::counter;
 using test::RecordingSink;
 using test::SimRigFixture;
-
-// Delegates to a camera; can stall (no frame for stall_ms once the next frame would be
-// stall_from frames were delivered) and offset the sequence numbers it reports.
-class WrappedCamera final : public hal::Camera {
- public:
-  explicit WrappedCamera(hal::Camera& inner) : inner_(inner) {}
-  std::uint64_t sequence_offset = 0;
-  std::uint64_t stall_from = ~std::uint64_t{0};
-  std::int64_t stall_ms = 0;
-
-  const std::string& name() const noexcept override { return inner_.name(); }
-  hal::CameraState state() const noexcept override { return inner_.state(); }
-  Expected<void> configure(const hal::CameraConfig& c) override { return inner_.configure(c); }
-  Expected<void> start() override { return inner_.start(); }
-  void stop() noexcept override { inner_.stop(); }
-  hal::CameraStatus trigger() noexcept override { return inner_.trigger(); }
-  hal::CameraStatus dequeue(hal::Frame& out, int timeout_ms) noexcept override {
-    const std::int64_t now = hal::monotonic_ns();
-    if (stall_until_ns_ == 0 && delivered_ >= stall_from)
-      stall_until_ns_ = now + stall_ms * 1'000'000;
-    if (now < stall_until_ns_) {  // stalled: frames pile up in the inner camera
-      hal::sleep_until_ns(std::min(stall_until_ns_, now + std::int64_t{timeout_ms} * 1'000'000));
-      return hal::CameraStatus::kTimeout;
-    }
-    const hal::CameraStatus st = inner_.dequeue(out, timeout_ms);
-    if (st != hal::CameraStatus::kOk) return st;
-    ++delivered_;
-    out.sequence += sequence_offset;
-    return hal::CameraStatus::kOk;
-  }
-  hal::CameraStatus release(const hal::Frame& f) noexcept override {
-    hal::Frame g = f;
-    g.sequence -= sequence_offset;
-    return inner_.release(g);
-  }
-  const hal::CameraConfig& config() const noexcept override { return inner_.config(); }
-  const std::string& notice() const noexcept override { return inner_.notice(); }
-  const hal::CameraCounters& counters() const noexcept override { return inner_.counters(); }
-
- private:
-  hal::Camera& inner_;
-  std::int64_t stall_until_ns_ = 0;
-  std::uint64_t delivered_ = 0;
-};
 
 TEST(PipelineFaults, NoUdpReceiverIsCountedNotFatal) {
   auto udp =
@@ -116,14 +73,15 @@ TEST(PipelineFaults, NoUdpReceiverIsCountedNotFatal) {
 
 TEST(PipelineFaults, StalledCameraIsReportedAndDoesNotBlockTheOther) {
   SimRigFixture rig(7);
-  WrappedCamera cam1(*rig.cams[1]);
-  cam1.stall_from = 40;
-  cam1.stall_ms = 300;
+  // After 40 frames, camera 1 stays silent for 60 dequeue calls: one per 5 ms trigger
+  // period (each waits until the next trigger), so at least 300 ms.
+  auto cam1 = hal::FaultCamera::wrap(*rig.cams[1], {{hal::Fault::kStall, 40, 60, 0}});
+  ASSERT_TRUE(cam1.ok()) << cam1.error().message;
   RecordingSink record(400);
   PipelineOptions opt = test::test_options();
   opt.max_frames = 160;
   opt.trigger_rate_hz = 200.0;
-  auto p = Pipeline::create(rig.processor(), {rig.cams[0].get(), &cam1}, {&record}, opt);
+  auto p = Pipeline::create(rig.processor(), {rig.cams[0].get(), cam1->get()}, {&record}, opt);
   ASSERT_TRUE(p.ok());
   ASSERT_TRUE((*p)->start().ok());
   std::int64_t max_silent_ms = 0;
@@ -163,8 +121,10 @@ TEST(PipelineFaults, FreeRunningCamerasPairByTimestamp) {
   }
   for (const PairBy mode : {PairBy::kTimestamp, PairBy::kSequence}) {
     SimRigFixture rig;
-    WrappedCamera cam1(*rig.cams[1]);
-    cam1.sequence_offset = 1000;  // independent counters: sequences never match
+    // Independent frame counters: camera 1's sequence numbers never match camera 0's.
+    auto cam1 = hal::FaultCamera::wrap(
+        *rig.cams[1], {{hal::Fault::kSequenceOffset, 0, hal::FaultRule::kForever, 1000}});
+    ASSERT_TRUE(cam1.ok()) << cam1.error().message;
     for (hal::Camera* c : {static_cast<hal::Camera*>(rig.cams[0].get()),
                            static_cast<hal::Camera*>(rig.cams[1].get())}) {
       hal::CameraConfig cfg = c->config();
@@ -176,7 +136,7 @@ TEST(PipelineFaults, FreeRunningCamerasPairByTimestamp) {
     PipelineOptions opt = test::test_options();
     opt.pair_by = mode;
     opt.pair_tolerance_us = 2000;  // the cameras start within microseconds of each other
-    auto p = Pipeline::create(rig.processor(), {rig.cams[0].get(), &cam1}, {&record}, opt);
+    auto p = Pipeline::create(rig.processor(), {rig.cams[0].get(), cam1->get()}, {&record}, opt);
     ASSERT_TRUE(p.ok()) << p.error().message;
     ASSERT_TRUE((*p)->start().ok());
     std::this_thread::sleep_for(std::chrono::milliseconds(400));

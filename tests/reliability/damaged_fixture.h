@@ -1,5 +1,5 @@
 // Design: shared set-up of the damaged-recording tests. One small simulated recording
-// (a few frames of the built-in scenario, rendered once per test binary) is copied into
+// (a few frames of the built-in scenario, rendered once per ctest run) is copied into
 // a fresh folder per test, damaged there, and `mocap track` is run on it under
 // `timeout` so that a hang fails the test instead of stalling CI. The outcome must be
 // one of the two the developers' rules allow: exit 0 having processed what it could
@@ -21,21 +21,34 @@
 
 namespace mocap::test {
 
-inline constexpr int kDamagedFrames = 6;
+#ifndef MOCAP_TEST_PRISTINE_FRAMES
+#define MOCAP_TEST_PRISTINE_FRAMES 6
+#endif
+inline constexpr int kDamagedFrames = MOCAP_TEST_PRISTINE_FRAMES;
 
-// The pristine recording (rendered once, never modified).
+// The pristine recording (never modified): the one ctest's fixture rendered for this run
+// (tests/reliability/CMakeLists.txt), or, when the binary runs on its own, one rendered
+// here once per process.
 inline const std::string& pristine_recording() {
   static std::unique_ptr<TempDir> dir;
   static std::string path;
-  if (!dir) {
-    dir = std::make_unique<TempDir>("reliability_src");
-    sim::SimOptions o;
-    o.frames = kDamagedFrames;
-    o.threads = 1;
-    path = dir->path() + "/rec";
-    auto r = sim::write_simulated_recording(o, path);
-    EXPECT_TRUE(r.ok()) << (r.ok() ? "" : r.error().message);
+  if (!path.empty()) return path;
+#ifdef MOCAP_TEST_PRISTINE_RECORDING
+  namespace fs = std::filesystem;
+  const std::string fixture = MOCAP_TEST_PRISTINE_RECORDING;
+  if (fs::exists(fixture + "/frames.csv") && fs::exists(fixture + "/gt/model_true.yaml") &&
+      std::max(0, line_count(read_file(fixture + "/frames.csv")) - 1) == kDamagedFrames) {
+    path = fixture;
+    return path;
   }
+#endif
+  dir = std::make_unique<TempDir>("reliability_src");
+  sim::SimOptions o;
+  o.frames = kDamagedFrames;
+  o.threads = 1;
+  path = dir->path() + "/rec";
+  auto r = sim::write_simulated_recording(o, path);
+  EXPECT_TRUE(r.ok()) << (r.ok() ? "" : r.error().message);
   return path;
 }
 

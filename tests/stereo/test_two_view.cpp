@@ -155,7 +155,7 @@ TEST(TwoView, Niter2EqualsPencilOptimumInTheWorkingVolume) {
   const Rig rig = test::paper_rig();
   std::mt19937 rng(1);
   std::vector<Vec3> pts;
-  for (int i = 0; i < 150; ++i) {
+  for (int i = 0; i < 60; ++i) {
     Vec2 a, b;
     pts.push_back(test::random_visible_point(rig, rng, a, b));
   }
