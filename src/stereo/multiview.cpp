@@ -261,9 +261,12 @@ bool MultiViewMerger::process(const Vec2* const* px, const int* n, const PointLi
       if (std::find(owners, owners + n_owners, o) == owners + n_owners) owners[n_owners++] = o;
       richer_owner = richer_owner || out[o].blob_index.count() > views;
     }
+    // The same point: the blobs of a taken point's hypothesis, or, for a point that gave
+    // views up (split_from_owners), exactly the views it kept.
     const bool same_as_taken = std::any_of(owners, owners + n_owners, [&](int o) {
       return hyp_[static_cast<std::size_t>(out_hyp_[static_cast<std::size_t>(o)])].blob_index ==
-             h.blob_index;
+                 h.blob_index ||
+             out[o].blob_index == h.blob_index;
     });
     if (same_as_taken) {
       ++counters_.merged;  // the same blobs: the same point from another pair
