@@ -33,6 +33,7 @@ MultiViewMerger::MultiViewMerger(const Rig& rig, const MultiViewConfig& config)
       config_(config),
       hyp_(static_cast<std::size_t>(config.max_hypotheses)),
       views_(static_cast<std::size_t>(config.max_hypotheses)),
+      partial_views_(static_cast<std::size_t>(config.max_hypotheses)),
       extended_(static_cast<std::size_t>(config.max_hypotheses)),
       out_hyp_(static_cast<std::size_t>(config.max_hypotheses)),
       order_(static_cast<std::size_t>(config.max_hypotheses)),
@@ -50,6 +51,8 @@ double MultiViewMerger::unfit_gate_px(int c, const Vec3& X_world) const noexcept
 // nearest blob beyond the gate but within the unfit gate is counted as an unfit view.
 void MultiViewMerger::extend(int i, const Vec2* const* px, const int* n) noexcept {
   Point3& h = hyp_[static_cast<std::size_t>(i)];
+  int& partial = partial_views_[static_cast<std::size_t>(i)];
+  partial = 0;
   for (int c = 0; c < camera_count(); ++c) {
     if (h.blob_index[c] >= 0) continue;
     Vec2 q;
@@ -71,6 +74,7 @@ void MultiViewMerger::extend(int i, const Vec2* const* px, const int* n) noexcep
       ++counters_.views_added;
     } else {
       ++counters_.unfit_views;
+      ++partial;
     }
   }
 }
@@ -227,6 +231,7 @@ bool MultiViewMerger::process(const Vec2* const* px, const int* n, const PointLi
       if (extended_[static_cast<std::size_t>(k)] == h.blob_index) same = k;
     if (same >= 0) {
       h = hyp_[static_cast<std::size_t>(same)];  // refined already
+      partial_views_[static_cast<std::size_t>(i)] = partial_views_[static_cast<std::size_t>(same)];
     } else {
       refine(i, px);
     }
@@ -236,6 +241,11 @@ bool MultiViewMerger::process(const Vec2* const* px, const int* n, const PointLi
   std::sort(order_.begin(), order_.begin() + count, [&](int a, int b) {
     const int va = views_[static_cast<std::size_t>(a)], vb = views_[static_cast<std::size_t>(b)];
     if (va != vb) return va > vb;
+    // Then the cameras that see part of the ball there: a ghost (two blobs of different
+    // markers on one epipolar line) has no image at all in the other cameras.
+    const int pa = partial_views_[static_cast<std::size_t>(a)];
+    const int pb = partial_views_[static_cast<std::size_t>(b)];
+    if (pa != pb) return pa > pb;
     const double ra = hyp_[static_cast<std::size_t>(a)].reproj_px;
     const double rb = hyp_[static_cast<std::size_t>(b)].reproj_px;
     return ra != rb ? ra < rb : a < b;

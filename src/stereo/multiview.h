@@ -115,6 +115,7 @@ class MultiViewMerger {
   MultiViewConfig config_;
   std::vector<Point3> hyp_;         // workspace: this frame's hypotheses
   std::vector<int> views_;          // views per hypothesis
+  std::vector<int> partial_views_;  // per hypothesis: cameras with only an unfit view
   std::vector<BlobRefs> extended_;  // blobs before refinement
   std::vector<int> out_hyp_;        // per output point: the hypothesis it came from
   std::vector<int> order_;          // hypotheses in acceptance order

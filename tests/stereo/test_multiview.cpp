@@ -286,6 +286,40 @@ TEST(MultiView, TwoBallsOnOneRayOfACameraAreBothReported) {
   EXPECT_EQ(st.merger.counters().shared_views_split, 1u);
 }
 
+// A marker seen whole by cameras 1 and 2 and only in part by camera 3 (its blob there
+// 6 px off its projection, within the ball's image), and a ghost: a camera-1 blob of
+// something else on the epipolar line of the marker's camera-2 blob, with no image in any
+// other camera. Both stand on two views, and the ghost fits exactly. The marker, which a
+// third camera partly confirms, is accepted first; the pairing of its camera-2 blob with
+// its partial view is then the marker again, not a rival a few millimetres off.
+TEST(MultiView, PartlySeenMarkerGoesBeforeAnExactGhost) {
+  const Rig rig = test::ring_rig();
+  MultiViewConfig config;
+  config.marker_radius_mm = 7.0;
+  Stage st(rig, config);
+  const Vec3 X(20.0, -10.0, 1000.0);
+  const Vec3 C2 = rig.cameras[2].center_world();
+  const Vec3 ghost = C2 + (X - C2) * (1.0 + 200.0 / (X - C2).norm());  // on camera 2's ray
+  Frame frame;
+  frame.px.resize(4);  // camera 0 sees nothing
+  Vec2 a1, a2, a3, g1;
+  ASSERT_TRUE(project(rig.cameras[1], X, a1) && project(rig.cameras[2], X, a2) &&
+              project(rig.cameras[3], X, a3) && project(rig.cameras[1], ghost, g1));
+  frame.px[1] = {a1 + Vec2(0.05, 0.0), g1};
+  frame.px[2] = {a2};
+  frame.px[3] = {a3 + Vec2(6.0, 0.0)};
+  st.run(frame);
+  int marker = 0, rivals = 0;
+  for (const Point3& p : st.out) {
+    const double d = (p.X_world - X).norm();
+    marker += d < 0.5;
+    rivals += d >= 0.5 && d < 20.0;
+  }
+  EXPECT_EQ(marker, 1);
+  EXPECT_EQ(rivals, 0);
+  EXPECT_GE(st.merger.counters().unfit_pairings, 1u);
+}
+
 TEST(MultiView, BallsCloserThanADiameterStayRivals) {
   const Rig rig = test::ring_rig();
   MultiViewConfig config;
