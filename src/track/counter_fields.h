@@ -68,8 +68,10 @@ inline constexpr std::array<CounterField<detect::DetectorCounters>, 13> kDetecto
 inline constexpr std::size_t kDetectorFramesOverflow = 3;
 static_assert(std::string_view(kDetectorFields[kDetectorFramesOverflow].name) == "frames_overflow");
 
-// Reported as stereo_<name>: the sum over the rig's camera pairs (StereoCounters::+=);
-// the per-camera fields are the first pair's two cameras.
+// Reported as stereo_<name>: the sum over the rig's camera pairs (StereoCounters::+=).
+// points_in_cam0 / _cam1 count the blobs given to each pair's first / second camera,
+// summed over the pairs: cameras 0 and 1 with two cameras; with more, the per-camera
+// blob counts are the detectors' (detect_cam<N>_*).
 inline constexpr std::array<CounterField<StereoCounters>, 14> kStereoFields = {{
     MOCAP_COUNTER_FIELD(StereoCounters, frames),
     {"points_in_cam0",
