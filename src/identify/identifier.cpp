@@ -30,7 +30,7 @@ Expected<Identifier> Identifier::create(const TargetSet& targets, const Identify
     if (!model) return model.error();
     models.push_back(std::move(*model));
   }
-  Identifier id(config, std::move(models));
+  Identifier id(config, std::move(models), targets.marker_diameter_mm);
   id.ambiguities_ = find_ambiguities(id.models_, config);
   for (const auto& f : id.ambiguities_) id.warnings_.push_back(f.message);
   if (config.ambiguity_policy == AmbiguityPolicy::kReject && !id.warnings_.empty())
@@ -38,11 +38,12 @@ Expected<Identifier> Identifier::create(const TargetSet& targets, const Identify
   return id;
 }
 
-Identifier::Identifier(const IdentifyConfig& config, std::vector<TargetModel> models)
+Identifier::Identifier(const IdentifyConfig& config, std::vector<TargetModel> models,
+                       double marker_diameter_mm)
     : config_(config),
       models_(std::move(models)),
       frame_(config.max_points),
-      search_(config),
+      search_(config, marker_diameter_mm),
       gate_(config),
       tracks_(models_.size()),
       results_(models_.size()),

@@ -77,7 +77,8 @@ class Identifier {
     std::int64_t t_prev_ns = 0;
   };
 
-  Identifier(const IdentifyConfig& config, std::vector<TargetModel> models);
+  Identifier(const IdentifyConfig& config, std::vector<TargetModel> models,
+             double marker_diameter_mm);
   Iso3 predict(const Track& track, std::int64_t t_ns) const noexcept;
   bool warm_match(int body, const Iso3& T_pred, SearchResult& out) noexcept;
   bool within_speed_limits(const Track& track, const Iso3& T, std::int64_t t_ns) const noexcept;

@@ -14,8 +14,9 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr auto kSeedLess = [](const auto& x, const auto& y) { return x.disc_mm < y.disc_mm; };
 }  // namespace
 
-TargetSearch::TargetSearch(const IdentifyConfig& config)
+TargetSearch::TargetSearch(const IdentifyConfig& config, double same_ball_mm)
     : config_(config),
+      same_ball_sq_mm2_(same_ball_mm > 0.0 ? same_ball_mm * same_ball_mm : 0.0),
       heap_(static_cast<std::size_t>(config.best_pairs)),
       next_(static_cast<std::size_t>(config.best_pairs), -1),
       src_(3, kMaxMarkers),
@@ -176,13 +177,18 @@ void TargetSearch::record(double score, const RigidFit& fit) noexcept {
 }
 
 // The current node contradicts the best solution unless one of the two is a subset of
-// the other (a subset or a superset tells the same identities).
+// the other (a subset or a superset tells the same identities). A marker on a point
+// within a ball's diameter of the best's point for it is the same identity: one ball
+// measured twice (e.g. whole, and partly hidden through another camera pair).
 bool TargetSearch::contradicts_best() const noexcept {
   const auto& best = best_->point_of_marker;
   int shared = 0;
   for (int s = 0; s < m_; ++s) {
     const int c = slot_marker_[static_cast<std::size_t>(s)];
-    if (best[static_cast<std::size_t>(c)] == slot_point_[static_cast<std::size_t>(s)]) ++shared;
+    const int bp = best[static_cast<std::size_t>(c)];
+    const int sp = slot_point_[static_cast<std::size_t>(s)];
+    if (bp == sp || (bp >= 0 && (frame_->X(bp) - frame_->X(sp)).squaredNorm() < same_ball_sq_mm2_))
+      ++shared;
   }
   return shared < m_ && shared < best_->m;
 }

@@ -11,7 +11,8 @@
 //     Eq. 1: sqrt(|r|^2 + m*floor^2) * base^(k-m) / m; the lowest score wins (ties: more m).
 //  3. Runner-up pass (if ambiguity_ratio > 1): the same search again, now keeping the
 //     best solution that contradicts the winner (a point on another marker or a marker
-//     on another point), pruned at ambiguity_ratio * best score. The caller rejects a
+//     on another point, unless that point is within a ball's diameter of the winner's:
+//     the same ball measured twice), pruned at ambiguity_ratio * best score. The caller rejects a
 //     winner whose rival is that close: an ambiguous frame gives no identity at all.
 //  4. Pruning that never loses the optimum of the explored seeds: a branch stops when a
 //     lower bound of any completion's score (|r| cannot shrink when points are added to a
@@ -51,7 +52,10 @@ struct SearchStats {
 
 class TargetSearch {
  public:
-  explicit TargetSearch(const IdentifyConfig& config);
+  // same_ball_mm: the marker balls' diameter (0: unknown). Two points closer than that are
+  // measurements of one ball (two balls cannot be closer), so a rival that puts a marker
+  // on such a point instead of the winner's does not contradict it.
+  explicit TargetSearch(const IdentifyConfig& config, double same_ball_mm = 0.0);
 
   // Searches `model` among the available points of `frame` (occupancy is restored on
   // return). Returns out.found.
@@ -77,6 +81,7 @@ class TargetSearch {
   void mark_seed(int seed_index) noexcept;
 
   IdentifyConfig config_;
+  double same_ball_sq_mm2_ = 0.0;
   std::vector<Seed> heap_;
   int heap_size_ = 0;
   // Processed seeds indexed by marker pair (a < b): head_[a][b] -> seed, next_[seed].

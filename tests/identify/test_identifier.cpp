@@ -198,6 +198,44 @@ TEST(Identifier, CountsOverflowAndInvalidPoints) {
   EXPECT_EQ(out.count, 1);
 }
 
+// One ball measured twice: whole, and partly hidden through another camera pair of a
+// multi-camera rig, 1 mm apart. The solutions that take one point or the other tell the
+// same identities (two balls cannot be closer than their diameter), so the body is found
+// from the whole point. Without a known diameter the two stay rivals, and the body is not
+// reported in that frame (the safe side).
+TEST(Identifier, OneBallMeasuredTwiceIsNotAnAmbiguity) {
+  for (const double diameter_mm : {12.0, 0.0}) {
+    SCOPED_TRACE(diameter_mm);
+    std::mt19937_64 rng(41);
+    TargetSet set;
+    set.marker_diameter_mm = diameter_mm;
+    set.bodies.push_back(random_target(rng, 5, "a"));
+    IdentifyConfig cfg;
+    cfg.temporal = false;
+    auto id = Identifier::create(set, cfg);
+    ASSERT_TRUE(id.ok()) << id.error().message;
+    Iso3 T_world_body = Iso3::Identity();
+    T_world_body.translation() = Vec3(30.0, -20.0, 1200.0);
+    std::vector<MeasuredPoint> pts;
+    for (const Vec3& m : set.bodies[0].markers_body) pts.push_back({T_world_body * m, {}, false});
+    MeasuredPoint twice = pts[0];
+    twice.X_world += Vec3(0.6, -0.8, 0.0);  // 1 mm off
+    twice.partial = true;
+    pts.push_back(twice);
+    BodyPoses out;
+    id->identify(pts.data(), static_cast<int>(pts.size()), 0, out);
+    if (diameter_mm > 0.0) {
+      ASSERT_TRUE(out.bodies[0].found);
+      EXPECT_EQ(out.bodies[0].point_index_of_marker[0], 0);  // the whole point
+      EXPECT_LT((out.bodies[0].T_world_body.translation() - T_world_body.translation()).norm(),
+                0.01);
+    } else {
+      EXPECT_FALSE(out.bodies[0].found);
+      EXPECT_EQ(id->counters().ambiguous_rejects, 1u);
+    }
+  }
+}
+
 // No targets (record/preview before any exist): a valid identifier that finds nothing.
 TEST(Identifier, WithoutTargetsFindsNothing) {
   auto id = Identifier::create(TargetSet{}, IdentifyConfig{});
