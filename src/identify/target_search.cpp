@@ -176,21 +176,28 @@ void TargetSearch::record(double score, const RigidFit& fit) noexcept {
         slot_point_[static_cast<std::size_t>(s)];
 }
 
-// The current node contradicts the best solution unless one of the two is a subset of
-// the other (a subset or a superset tells the same identities). A marker on a point
-// within a ball's diameter of the best's point for it is the same identity: one ball
-// measured twice (e.g. whole, and partly hidden through another camera pair).
+// The current node contradicts the best solution when it puts a marker on another point
+// than the best does, or a point on another marker: the two then tell different
+// identities. Solutions that agree wherever both assign (a subset, a superset, or two
+// that complete each other) do not. A marker on a point within a ball's diameter of the
+// best's point for it is the same identity: one ball measured twice (e.g. whole, and
+// partly hidden through another camera pair).
 bool TargetSearch::contradicts_best() const noexcept {
   const auto& best = best_->point_of_marker;
-  int shared = 0;
+  const int k = model_->k;
   for (int s = 0; s < m_; ++s) {
     const int c = slot_marker_[static_cast<std::size_t>(s)];
-    const int bp = best[static_cast<std::size_t>(c)];
     const int sp = slot_point_[static_cast<std::size_t>(s)];
-    if (bp == sp || (bp >= 0 && (frame_->X(bp) - frame_->X(sp)).squaredNorm() < same_ball_sq_mm2_))
-      ++shared;
+    const int bp = best[static_cast<std::size_t>(c)];
+    if (bp == sp) continue;
+    if (bp >= 0) {  // the marker on another point
+      if ((frame_->X(bp) - frame_->X(sp)).squaredNorm() >= same_ball_sq_mm2_) return true;
+      continue;
+    }
+    for (int a = 0; a < k; ++a)  // the point on another marker
+      if (best[static_cast<std::size_t>(a)] == sp) return true;
   }
-  return shared < m_ && shared < best_->m;
+  return false;
 }
 
 void TargetSearch::run_pass() noexcept {

@@ -2,6 +2,7 @@
 // reference, mutually exclusive candidates, and the setup-time validation.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 
 #include "identify/exhaustive_search.h"
@@ -91,6 +92,44 @@ TEST(TargetSearch, AgreesWithExhaustiveSearch) {
 }
 
 // Two points sharing a blob in one camera: a solution uses at most one of them.
+// The rival (runner-up pass) always contradicts the winner: a marker on another point
+// (farther than a ball's diameter: nearer, it is the same ball measured twice), or a
+// point on another marker. Solutions that agree wherever both assign, such as two
+// 4-marker solutions of a 5-marker target that complete each other, tell the same
+// identities and are never each other's rival (before: any two solutions of which neither
+// was a subset of the other were rivals, and the body was dropped as ambiguous).
+TEST(TargetSearch, RivalAlwaysContradictsTheWinner) {
+  std::mt19937_64 rng(23);
+  IdentifyConfig cfg;
+  const double diameter_mm = 12.0;
+  FramePoints frame(cfg.max_points);
+  TargetSearch search(cfg, diameter_mm);
+  int rivals = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    TargetSet set;
+    set.bodies.push_back(random_target(rng, 5, "a"));
+    const TargetModel model = model_of(set.bodies[0]);
+    const auto scene = make_scene(rng, set, SceneOptions{1.5, 10, true, 3, 300.0});
+    frame.load(scene.pts.data(), static_cast<int>(scene.pts.size()), model.max_pair_mm + cfg.t_mm);
+    SearchResult r;
+    SearchStats st;
+    if (!search.run(model, frame, r, st) || !std::isfinite(r.rival_score)) continue;
+    ++rivals;
+    bool contradicts = false;
+    for (int c = 0; c < model.k; ++c) {
+      const int bp = r.point_of_marker[static_cast<std::size_t>(c)];
+      const int rp = r.rival_point_of_marker[static_cast<std::size_t>(c)];
+      if (rp < 0 || rp == bp) continue;
+      if (bp >= 0 && (frame.X(bp) - frame.X(rp)).norm() >= diameter_mm) contradicts = true;
+      for (int a = 0; a < model.k; ++a)
+        contradicts =
+            contradicts || (a != c && r.point_of_marker[static_cast<std::size_t>(a)] == rp);
+    }
+    EXPECT_TRUE(contradicts) << "trial " << trial;
+  }
+  EXPECT_GT(rivals, 10);  // the property was exercised
+}
+
 TEST(TargetSearch, MutuallyExclusiveCandidatesNotBothUsed) {
   std::mt19937_64 rng(3);
   const MarkerTarget t = random_target(rng, 5, "a");
