@@ -190,12 +190,10 @@ bool TargetSearch::contradicts_best() const noexcept {
     const int sp = slot_point_[static_cast<std::size_t>(s)];
     const int bp = best[static_cast<std::size_t>(c)];
     if (bp == sp) continue;
-    if (bp >= 0) {  // the marker on another point
-      if ((frame_->X(bp) - frame_->X(sp)).squaredNorm() >= same_ball_sq_mm2_) return true;
-      continue;
-    }
+    // The marker on another point (not the same ball).
+    if (bp >= 0 && (frame_->X(bp) - frame_->X(sp)).squaredNorm() >= same_ball_sq_mm2_) return true;
     for (int a = 0; a < k; ++a)  // the point on another marker
-      if (best[static_cast<std::size_t>(a)] == sp) return true;
+      if (a != c && best[static_cast<std::size_t>(a)] == sp) return true;
   }
   return false;
 }
