@@ -42,6 +42,10 @@ Expected<std::unique_ptr<Pipeline>> Pipeline::create(FrameProcessor processor,
     return make_error("pipeline", "trigger_rate_hz",
                       "must be in [0.01, 10000], got " + std::to_string(options.trigger_rate_hz));
   }
+  if (options.cpu_latency_us < -1 || options.cpu_latency_us > rt::kMaxCpuLatencyUs) {
+    return make_error("pipeline", "cpu_latency_us",
+                      "must be in -1..1000000, got " + std::to_string(options.cpu_latency_us));
+  }
   if (options.dequeue_timeout_ms < 1 || options.dequeue_timeout_ms > 1000) {
     return make_error("pipeline", "dequeue_timeout_ms", "must be in 1..1000");
   }
@@ -111,11 +115,16 @@ Expected<void> Pipeline::start() {
   if (options_.lock_memory) {
     if (std::string note = rt::lock_memory(); !note.empty()) notes_.push_back(note);
   }
+  if (options_.cpu_latency_us >= 0) {
+    if (std::string note = cpu_latency_.request(options_.cpu_latency_us); !note.empty())
+      notes_.push_back(note);
+  }
   const int n = camera_count();
   for (int c = 0; c < n; ++c) {
     if (auto r = cameras_[static_cast<std::size_t>(c)]->start(); !r) {
       for (int started = 0; started < c; ++started)
         cameras_[static_cast<std::size_t>(started)]->stop();
+      cpu_latency_.release();
       return r.error();
     }
   }
@@ -184,6 +193,7 @@ void Pipeline::stop() noexcept {
   identify_->drain();
   publish_->drain();
   for (hal::Camera* cam : cameras_) cam->stop();
+  cpu_latency_.release();
   running_ = false;
 }
 

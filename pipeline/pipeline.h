@@ -47,6 +47,7 @@
 #include "pipeline/publish_stage.h"
 #include "pipeline/stage_context.h"
 #include "pipeline/stage_table.h"
+#include "rt/cpu_latency.h"
 #include "rt/thread.h"
 #include "track/frame_processor.h"
 
@@ -77,7 +78,8 @@ class Pipeline final : public HealthSource {
   Pipeline& operator=(const Pipeline&) = delete;
 
   // Allocates every ring and slot, starts the cameras and the 3 + cameras threads. The
-  // fallbacks taken (no SCHED_FIFO, no mlockall, no pinning) are in notes().
+  // fallbacks taken (no SCHED_FIFO, no mlockall, no pinning, no CPU latency request) are
+  // in notes().
   Expected<void> start();
   // Stops triggering, joins every thread (each wakes within ~20 ms), returns every
   // buffer to its camera and stops the cameras. Idempotent.
@@ -133,6 +135,7 @@ class Pipeline final : public HealthSource {
   std::vector<std::unique_ptr<DetectStage>> detect_;
   std::unique_ptr<CaptureStage> capture_;
   std::vector<rt::RtThread> threads_;
+  rt::CpuLatencyRequest cpu_latency_;  // held from start() to stop()
   std::int64_t start_ns_ = 0, stop_ns_ = 0;
 };
 

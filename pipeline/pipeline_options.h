@@ -50,10 +50,14 @@ class StageHooks {
 };
 
 struct PipelineOptions {
-  StageTable stages{};             // the rule per stage kind + per-camera detect overrides
-  int cpu_count = 0;               // CPUs the detect rule spreads over; 0: this machine's (online)
-  bool realtime = true;            // apply the table's CPU pinning and SCHED_FIFO (fallback noted)
-  bool lock_memory = true;         // mlockall (fallback noted)
+  StageTable stages{};      // the rule per stage kind + per-camera detect overrides
+  int cpu_count = 0;        // CPUs the detect rule spreads over; 0: this machine's (online)
+  bool realtime = true;     // apply the table's CPU pinning and SCHED_FIFO (fallback noted)
+  bool lock_memory = true;  // mlockall (fallback noted)
+  // PM QoS CPU latency limit held while running (rt/cpu_latency.h, fallback noted): 0
+  // keeps idle CPUs polling, so a stage woken by its doorbell runs without an idle-state
+  // exit; -1: no request (the kernel's idle governor decides).
+  int cpu_latency_us = 0;
   double trigger_rate_hz = 100.0;  // software-triggered cameras
   TriggerPacing pacing = TriggerPacing::kPeriodic;
   std::uint64_t max_frames = 0;  // stop triggering after this many (0: unlimited)

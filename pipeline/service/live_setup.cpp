@@ -93,6 +93,7 @@ pipeline::PipelineOptions pipeline_options(const config::RunConfig& cfg) {
   o.pacing = cfg.pipeline.pacing;
   o.realtime = cfg.pipeline.realtime;
   o.lock_memory = cfg.pipeline.lock_memory;
+  o.cpu_latency_us = cfg.pipeline.cpu_latency_us;
   o.dequeue_timeout_ms = cfg.pipeline.dequeue_timeout_ms;
   for (std::size_t i = 0; i < config::kStageCount; ++i) {
     const config::StageSettings& s = cfg.pipeline.stages[i];

@@ -127,14 +127,16 @@ void read_cameras(const YAML::Node& node, const std::string& dir, RunConfig& cfg
 }
 
 void read_pipeline(const YAML::Node& node, PipelineSettings& p) {
-  const Section s(
-      node, "pipeline",
-      {"trigger_rate_hz", "pacing", "realtime", "lock_memory", "dequeue_timeout_ms", "stages"});
+  const Section s(node, "pipeline",
+                  {"trigger_rate_hz", "pacing", "realtime", "lock_memory", "cpu_latency_us",
+                   "dequeue_timeout_ms", "stages"});
   set(p.trigger_rate_hz, s.number("trigger_rate_hz", kMinTriggerRateHz, kMaxTriggerRateHz));
   set(p.pacing, s.choice<TriggerPacing>("pacing", {{"periodic", TriggerPacing::kPeriodic},
                                                    {"lockstep", TriggerPacing::kLockstep}}));
   set(p.realtime, s.flag("realtime"));
   set(p.lock_memory, s.flag("lock_memory"));
+  // rt::kMaxCpuLatencyUs (rt/cpu_latency.h; config does not link the rt layer).
+  set(p.cpu_latency_us, s.integer("cpu_latency_us", -1, 1'000'000));
   set(p.dequeue_timeout_ms, s.integer("dequeue_timeout_ms", 1, 1000));
   // Keys: the stage kinds, then detect0..detect<kMaxCameras-1> (one camera's detect stage).
   std::vector<std::string> keys(kStageNames.begin(), kStageNames.end());

@@ -65,6 +65,7 @@ struct PipelineSettings {
   TriggerPacing pacing = TriggerPacing::kPeriodic;
   bool realtime = true;     // CPU pinning + SCHED_FIFO (falls back when not permitted)
   bool lock_memory = true;  // mlockall (falls back when not permitted)
+  int cpu_latency_us = 0;   // PM QoS CPU latency while running; -1: none (rt/cpu_latency.h)
   int dequeue_timeout_ms = 20;
   std::array<StageSettings, kStageCount> stages{};
   std::array<StageSettings, kMaxCameras> detect_camera{};  // stages.detect<k>

@@ -137,6 +137,8 @@ const ErrorCase kCases[] = {
      "pipeline.pacing: expected periodic|lockstep, got 'fast' (line 1)"},
     {"RealtimeNotABool", "pipeline: {realtime: yes}\n",
      "pipeline.realtime: expected true or false, got 'yes' (line 1)"},
+    {"CpuLatencyTooLow", "pipeline: {cpu_latency_us: -2}\n",
+     "pipeline.cpu_latency_us: must be in [-1, 1000000], got -2 (line 1)"},
     {"DequeueTimeout", "pipeline: {dequeue_timeout_ms: 0}\n",
      "pipeline.dequeue_timeout_ms: must be in [1, 1000], got 0 (line 1)"},
     {"UnknownStage", "pipeline: {stages: {triangulate: {cpu: 0}}}\n",

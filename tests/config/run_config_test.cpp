@@ -74,7 +74,8 @@ TEST(RunConfig, ThresholdsAndOutputsAreRead) {
              "            roi: {x: 10, y: 20, width: 100, height: 50}, border: reject}\n"
              "stereo: {epipolar_tolerance_px: 1.5, min_depth_mm: 200, max_depth_mm: 5000}\n"
              "identification: {t_mm: 4, min_markers: 4, temporal: false}\n"
-             "pipeline: {pacing: lockstep, realtime: false, stages: {publish: {cpu: -1}}}\n"
+             "pipeline: {pacing: lockstep, realtime: false, cpu_latency_us: 50,\n"
+             "           stages: {publish: {cpu: -1}}}\n"
              "fault_injection: {stall_after_frames: 50}\n");
   auto cfg = load_run_config(dir.file("m.yaml"));
   ASSERT_TRUE(cfg) << cfg.error().message;
@@ -89,6 +90,7 @@ TEST(RunConfig, ThresholdsAndOutputsAreRead) {
   EXPECT_FALSE(cfg->tracker.identify.temporal);
   EXPECT_EQ(cfg->pipeline.pacing, TriggerPacing::kLockstep);
   EXPECT_FALSE(cfg->pipeline.realtime);
+  EXPECT_EQ(cfg->pipeline.cpu_latency_us, 50);
   EXPECT_EQ(*cfg->pipeline.stages[3].cpu, -1);
   EXPECT_EQ(cfg->faults.stall_after_frames, 50u);
 }

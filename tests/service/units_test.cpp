@@ -67,6 +67,13 @@ TEST(SystemdUnits, ServiceSettings) {
         "SupplementaryGroups=video\n", "LimitRTPRIO=", "LimitMEMLOCK=infinity\n",
         "CPUAffinity=", "StateDirectory=mocap\n", "LogsDirectory=mocap\n", "--check-config"})
     EXPECT_NE(m.find(line), std::string::npos) << "mocap.service lacks " << line;
+  // The CPU latency request (pipeline.cpu_latency_us): the device is allowed in the unit's
+  // closed device policy, and the udev rule gives it to the service's group.
+  EXPECT_NE(m.find("\nDeviceAllow=/dev/cpu_dma_latency rw\n"), std::string::npos);
+  const std::string rule = read_file(source_dir() + "/deploy/60-mocap-cpu-latency.rules");
+  EXPECT_NE(rule.find("\nKERNEL==\"cpu_dma_latency\", GROUP=\"mocap\", MODE=\"0660\"\n"),
+            std::string::npos)
+      << rule;
   // The same primary group for RouDi (iceoryx requirement).
   EXPECT_NE(r.find("Group=mocap\n"), std::string::npos);
   // iceoryx needs the host's /tmp and /dev/shm.
