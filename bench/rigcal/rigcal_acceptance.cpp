@@ -117,7 +117,8 @@ int main(int argc, char** argv) {
                    : mode == "fixed" ? rigcal::IntrinsicsMode::kFixed
                                      : rigcal::IntrinsicsMode::kAuto;
   if (const char* r = std::getenv("RIGCAL_MIN_ROUNDNESS")) opt.min_roundness = std::atof(r);
-  auto blobs = rigcal::detect_recording(dir + "/wand", opt.detector, opt.min_roundness, &intr);
+  auto blobs = rigcal::detect_recording(dir + "/wand", opt.detector, opt.min_roundness, &intr,
+                                        opt.edge_centres);
   if (!blobs) return 1;
   auto t2 = std::chrono::steady_clock::now();
   auto res = rigcal::calibrate_from_blobs(*blobs, sim::default_calibration_objects().wand, intr,
@@ -205,7 +206,8 @@ int main(int argc, char** argv) {
   const double rms_true = std::sqrt(ss_true / std::max(1, n));
   const double rms_cal = std::sqrt(ss_cal / std::max(1, n));
   // Ground frame.
-  auto lb = rigcal::detect_recording(dir + "/lframe", opt.detector, opt.min_roundness, &intr);
+  auto lb = rigcal::detect_recording(dir + "/lframe", opt.detector, opt.min_roundness, &intr,
+                                     opt.edge_centres);
   if (!lb) return 1;
   rigcal::RigCalResult with_ground = *res;
   if (auto r = rigcal::set_ground_frame(with_ground, *lb, sim::default_calibration_objects().lframe,

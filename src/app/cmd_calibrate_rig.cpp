@@ -154,12 +154,14 @@ int run(const RigArgs& a) {
       intr[c] = m;
     }
   }
-  auto blobs = rigcal::detect_recording(a.recording, opt.detector, opt.min_roundness, &intr);
+  auto blobs = rigcal::detect_recording(a.recording, opt.detector, opt.min_roundness, &intr,
+                                        opt.edge_centres);
   if (!blobs) return fail(blobs.error().message);
   auto result = rigcal::calibrate_from_blobs(*blobs, objects->wand, intr, opt, a.recording);
   if (!result) return fail(result.error().message);
   if (!a.lframe.empty()) {
-    auto lb = rigcal::detect_recording(a.lframe, opt.detector, opt.min_roundness, &intr);
+    auto lb = rigcal::detect_recording(a.lframe, opt.detector, opt.min_roundness, &intr,
+                                       opt.edge_centres);
     if (!lb) return fail(lb.error().message);
     if (auto r = rigcal::set_ground_frame(*result, *lb, objects->lframe, opt, a.lframe); !r)
       return fail(r.error().message);

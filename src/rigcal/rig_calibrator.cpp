@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "detect/blob_detector.h"
+#include "detect/edge_centre.h"
 #include "formats/recording.h"
 #include "rigcal/pairwise_init.h"
 #include "rigcal/rig_quality.h"
@@ -33,7 +34,7 @@ Expected<void> check_camera_count(std::size_t cameras, const std::string& record
                         std::to_string(kMinRigCameras) + " to " + std::to_string(kMaxRigCameras));
 }
 
-double expected_roundness(const CameraModel& cam, const Vec2& px) noexcept {
+double expected_radial_stretch(const CameraModel& cam, const Vec2& px) noexcept {
   Vec2 xn;
   if (!undistort_pixel(cam, px, xn)) return 1.0;
   const double r2 = xn.squaredNorm();
@@ -41,13 +42,19 @@ double expected_roundness(const CameraModel& cam, const Vec2& px) noexcept {
   const auto& k = cam.distortion;
   const double s_t = 1.0 + k[0] * r2 + k[1] * r4 + k[4] * r4 * r2;
   const double s_r = 1.0 + 3.0 * k[0] * r2 + 5.0 * k[1] * r4 + 7.0 * k[4] * r4 * r2;
-  const double radial = s_r * std::sqrt(1.0 + r2);  // 1 / cos(off-axis angle)
-  const double a = std::fabs(radial), b = std::fabs(s_t);
-  return std::max(a, b) > 0.0 ? std::min(a, b) / std::max(a, b) : 1.0;
+  const double radial = std::fabs(s_r * std::sqrt(1.0 + r2));  // 1 / cos(off-axis angle)
+  const double tangential = std::fabs(s_t);
+  return radial > 0.0 && tangential > 0.0 ? radial / tangential : 1.0;
+}
+
+double expected_roundness(const CameraModel& cam, const Vec2& px) noexcept {
+  const double s = expected_radial_stretch(cam, px);
+  return s > 1.0 ? 1.0 / s : s;
 }
 
 Expected<FrameBlobs> detect_recording(const std::string& dir, const detect::DetectorConfig& cfg,
-                                      double min_roundness, const std::vector<CameraModel>* cams) {
+                                      double min_roundness, const std::vector<CameraModel>* cams,
+                                      bool edge_centres) {
   auto rec = Recording::open(dir);
   if (!rec) return rec.error();
   const std::size_t C = rec->rig().cameras.size();
@@ -76,11 +83,18 @@ Expected<FrameBlobs> detect_recording(const std::string& dir, const detect::Dete
         if (b.has(detect::kBlobTouchesBorder) || b.has(detect::kBlobMerged) ||
             b.has(detect::kBlobSplit))
           continue;
-        const Vec2 px(b.x_px, b.y_px);
+        Vec2 px(b.x_px, b.y_px);
+        const CameraModel& cam = cams ? (*cams)[c] : rec->rig().cameras[c];
         if (min_roundness > 0.0 &&
-            static_cast<double>(b.roundness) <
-                min_roundness * expected_roundness(cams ? (*cams)[c] : rec->rig().cameras[c], px))
+            static_cast<double>(b.roundness) < min_roundness * expected_roundness(cam, px))
           continue;
+        if (edge_centres) {
+          const Vec2 radial = px - Vec2(cam.cx, cam.cy);
+          const detect::EdgeCentre e =
+              detect::edge_centre(img[c].view(), b, list.levels().noise_dn, radial.x(), radial.y(),
+                                  expected_radial_stretch(cam, px));
+          if (e.ok) px = Vec2(e.x_px, e.y_px);
+        }
         out[f][c].push_back(px);
       }
     }

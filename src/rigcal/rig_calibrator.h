@@ -42,6 +42,7 @@ enum class IntrinsicsMode { kAuto, kRefine, kFixed };
 struct RigCalOptions {
   detect::DetectorConfig detector{};
   double min_roundness = 0.95;  // of the expected roundness (detect_recording)
+  bool edge_centres = true;     // balls' centres from their edges (detect_recording)
   WandLabelConfig label{};
   IntrinsicsMode intrinsics = IntrinsicsMode::kAuto;
   int min_frames = 30;            // fewer frames with the wand in >= 2 cameras: error; also the
@@ -102,14 +103,22 @@ Expected<void> check_camera_count(std::size_t cameras, const std::string& record
 // image is an ellipse stretched radially by perspective and squeezed by barrel
 // distortion, expected_roundness()): a partly hidden marker has a biased centre.
 // cams: the intrinsics for that expectation (the recording's rig.yaml when null).
+// edge_centres: each kept blob's centre is its silhouette edge's (detect/edge_centre.h,
+// with the shape a whole ball has there): a wand's rod hides a notch of each ball's rim
+// and biases the intensity centroid along the wand; the centroid stays where the edge
+// fit fails.
 Expected<FrameBlobs> detect_recording(const std::string& dir, const detect::DetectorConfig& cfg,
                                       double min_roundness = 0.0,
-                                      const std::vector<CameraModel>* cams = nullptr);
+                                      const std::vector<CameraModel>* cams = nullptr,
+                                      bool edge_centres = false);
 
 // Minor/major axis ratio of a small ball's image centred at pixel px (first order:
 // perspective stretch 1/cos(off-axis angle) and the distortion's radial/tangential
 // scales).
 double expected_roundness(const CameraModel& cam, const Vec2& px) noexcept;
+// The same shape as the ratio of its radial extent (along the line from the principal
+// point) to its tangential extent: > 1 stretched radially, < 1 squeezed (1 on failure).
+double expected_radial_stretch(const CameraModel& cam, const Vec2& px) noexcept;
 
 // The calibration from already detected blobs. intrinsics: the cameras' intrinsics
 // (2..8; names and sizes must be set; extrinsics ignored), blobs with one entry per

@@ -60,6 +60,32 @@ inline double coverage(const Spot& s, int px, int py) {
   return static_cast<double>(n) / (kSub * kSub);
 }
 
+// Gaussian blur of a light field (p.blur_sigma_px; none when 0), separable, clamped edges.
+inline void blur(std::vector<double>& f, const SynthParams& p) {
+  if (p.blur_sigma_px <= 0.0) return;
+  const int r = static_cast<int>(std::ceil(3.0 * p.blur_sigma_px));
+  std::vector<double> k(static_cast<std::size_t>(2 * r + 1));
+  double sum = 0.0;
+  for (int i = -r; i <= r; ++i)
+    sum += k[i + r] = std::exp(-0.5 * i * i / (p.blur_sigma_px * p.blur_sigma_px));
+  for (double& v : k) v /= sum;
+  std::vector<double> tmp(f.size());
+  for (int pass = 0; pass < 2; ++pass) {
+    for (int y = 0; y < p.height; ++y) {
+      for (int x = 0; x < p.width; ++x) {
+        double acc = 0.0;
+        for (int i = -r; i <= r; ++i) {
+          const int xx = std::clamp(pass == 0 ? x + i : x, 0, p.width - 1);
+          const int yy = std::clamp(pass == 0 ? y : y + i, 0, p.height - 1);
+          acc += k[i + r] * f[static_cast<std::size_t>(yy) * p.width + xx];
+        }
+        tmp[static_cast<std::size_t>(y) * p.width + x] = acc;
+      }
+    }
+    f.swap(tmp);
+  }
+}
+
 // Linear light (background + spots, blurred) before noise and quantisation.
 inline std::vector<double> render_light(const std::vector<Spot>& spots, const SynthParams& p) {
   std::vector<double> f(static_cast<std::size_t>(p.width) * static_cast<std::size_t>(p.height),
@@ -74,29 +100,7 @@ inline std::vector<double> render_light(const std::vector<Spot>& spots, const Sy
       }
     }
   }
-  if (p.blur_sigma_px > 0.0) {
-    const int r = static_cast<int>(std::ceil(3.0 * p.blur_sigma_px));
-    std::vector<double> k(static_cast<std::size_t>(2 * r + 1));
-    double sum = 0.0;
-    for (int i = -r; i <= r; ++i)
-      sum += k[i + r] = std::exp(-0.5 * i * i / (p.blur_sigma_px * p.blur_sigma_px));
-    for (double& v : k) v /= sum;
-    std::vector<double> tmp(f.size());
-    for (int pass = 0; pass < 2; ++pass) {
-      for (int y = 0; y < p.height; ++y) {
-        for (int x = 0; x < p.width; ++x) {
-          double acc = 0.0;
-          for (int i = -r; i <= r; ++i) {
-            const int xx = std::clamp(pass == 0 ? x + i : x, 0, p.width - 1);
-            const int yy = std::clamp(pass == 0 ? y : y + i, 0, p.height - 1);
-            acc += k[i + r] * f[static_cast<std::size_t>(yy) * p.width + xx];
-          }
-          tmp[static_cast<std::size_t>(y) * p.width + x] = acc;
-        }
-      }
-      f.swap(tmp);
-    }
-  }
+  blur(f, p);
   return f;
 }
 

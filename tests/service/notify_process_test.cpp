@@ -276,8 +276,8 @@ TEST(ServiceProcess, CheckConfigRejectsWithOneLine) {
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_EQ(r.output, "mocap: " + dir.file("bad.yaml") +
                           ": pipeline.trigger_rate: unknown key (line 2); expected one of: "
-                          "trigger_rate_hz, pacing, realtime, lock_memory, dequeue_timeout_ms, "
-                          "stages\n");
+                          "trigger_rate_hz, pacing, realtime, lock_memory, cpu_latency_us, "
+                          "dequeue_timeout_ms, stages\n");
 }
 
 TEST(ServiceProcess, RunWithABadConfigFailsBeforeStarting) {
