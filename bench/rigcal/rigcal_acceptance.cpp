@@ -10,6 +10,9 @@
 //    the truth is mapped with the true T_cam0_world); RMS 3D error of both;
 //  - ground frame: camera centres and rotations of the L-frame rig vs the truth.
 // Usage: rigcal_acceptance [frames] [seed] [intrinsics: true|perturbed] [mode: auto|refine|fixed]
+// Environment: RIGCAL_MIN_ROUNDNESS (the blob filter), RIGCAL_CENTRES = centroid | edge |
+// axis (the wand balls' centres: intensity centroid, edge fit, edge fit without the rim
+// along the wand's axis; default axis, as mocap calibrate-rig).
 #include <Eigen/Geometry>
 #include <chrono>
 #include <cmath>
@@ -117,12 +120,17 @@ int main(int argc, char** argv) {
                    : mode == "fixed" ? rigcal::IntrinsicsMode::kFixed
                                      : rigcal::IntrinsicsMode::kAuto;
   if (const char* r = std::getenv("RIGCAL_MIN_ROUNDNESS")) opt.min_roundness = std::atof(r);
-  auto blobs = rigcal::detect_recording(dir + "/wand", opt.detector, opt.min_roundness, &intr,
-                                        opt.edge_centres);
+  // RIGCAL_CENTRES=centroid | edge (no wand axis) | axis (default, as the command does).
+  const std::string centres =
+      std::getenv("RIGCAL_CENTRES") ? std::getenv("RIGCAL_CENTRES") : "axis";
+  opt.edge_centres = centres != "centroid";
+  const WandSpec wand = sim::default_calibration_objects().wand;
+  auto blobs =
+      rigcal::detect_recording(dir + "/wand", opt.detector, opt.min_roundness, &intr,
+                               opt.edge_centres, centres == "axis" ? &wand : nullptr, opt.label);
   if (!blobs) return 1;
   auto t2 = std::chrono::steady_clock::now();
-  auto res = rigcal::calibrate_from_blobs(*blobs, sim::default_calibration_objects().wand, intr,
-                                          opt, dir + "/wand");
+  auto res = rigcal::calibrate_from_blobs(*blobs, wand, intr, opt, dir + "/wand");
   if (!res) {
     std::fprintf(stderr, "%s\n", res.error().message.c_str());
     return 1;

@@ -155,7 +155,7 @@ int run(const RigArgs& a) {
     }
   }
   auto blobs = rigcal::detect_recording(a.recording, opt.detector, opt.min_roundness, &intr,
-                                        opt.edge_centres);
+                                        opt.edge_centres, &objects->wand, opt.label);
   if (!blobs) return fail(blobs.error().message);
   auto result = rigcal::calibrate_from_blobs(*blobs, objects->wand, intr, opt, a.recording);
   if (!result) return fail(result.error().message);

@@ -60,8 +60,8 @@ struct Pt {
 }  // namespace
 
 EdgeCentre edge_centre(const ImageView& img, const Blob& blob, double noise_dn, double radial_x,
-                       double radial_y, double radial_stretch,
-                       const EdgeCentreConfig& cfg) noexcept {
+                       double radial_y, double radial_stretch, const EdgeCentreConfig& cfg,
+                       EdgeAxis axis) noexcept {
   EdgeCentre out;
   const int rays = std::clamp(cfg.rays, 8, kMaxEdgeRays);
   const double bg = blob.background_dn, peak = blob.peak_dn;
@@ -99,8 +99,29 @@ EdgeCentre edge_centre(const ImageView& img, const Blob& blob, double noise_dn, 
       prev = v;
     }
   }
+  // An occluder axis: leave out the rays within axis_half_angle_deg of it.
+  int used_rays = rays;
+  const double an = std::hypot(axis.x, axis.y);
+  if (an > 0.0 && n > 0) {
+    const double half = std::clamp(cfg.axis_half_angle_deg, 0.0, 70.0) * M_PI / 180.0;
+    const double ax = axis.x / an, ay = axis.y / an, cos_half = std::cos(half);
+    int kept = 0;
+    used_rays = 0;
+    for (int k = 0; k < rays; ++k) {
+      const double a = 2.0 * M_PI * k / rays;
+      used_rays += std::fabs(std::cos(a) * ax + std::sin(a) * ay) > cos_half ? 0 : 1;
+    }
+    for (int i = 0; i < n; ++i) {
+      const Pt& q = pts[static_cast<std::size_t>(i)];
+      const double a = 2.0 * M_PI * q.ray / rays;
+      if (std::fabs(std::cos(a) * ax + std::sin(a) * ay) > cos_half) continue;
+      pts[static_cast<std::size_t>(kept++)] = q;
+    }
+    n = kept;
+  }
   out.edge_points = n;
-  const int min_inliers = std::max(6, static_cast<int>(std::ceil(cfg.min_inlier_fraction * rays)));
+  const int min_inliers =
+      std::max(6, static_cast<int>(std::ceil(cfg.min_inlier_fraction * used_rays)));
   if (n < min_inliers) return out;
 
   // Kasa's fit over all points: x^2 + y^2 + D x + E y + F = 0.

@@ -16,6 +16,15 @@
 // `inlier_sigmas` times the edge noise, which is derived from the image noise and the
 // edge's own intensity gradient (sigma_edge = noise_dn / |dI/dr|), never below the
 // spread of the points themselves (MAD). The centre is mapped back into the image.
+// Known occluder axis: when the caller knows the line along which an occluder enters
+// the ball (a wand's rod and handle run along the wand), the rays within
+// `axis_half_angle_deg` of either direction of that axis are not used at all: the rim
+// there may be hidden by an amount too small to reject (a thin rod's blurred flank), and
+// whatever bias it leaves points along the axis. The two remaining arcs are symmetric
+// about the axis, so the fitted radius cannot trade against the centre's position along
+// it. 45 degrees leaves out the rim a rod up to 0.7 x the ball's radius hides in a sharp
+// image, or up to ~0.4 x when the blur spans 20 degrees of the rim (a ball 3 px in
+// radius): a wand seen from 2-3 m.
 // Not ok (use the centroid): a faint blob, too few edge points, or too few inliers.
 // No allocation (fixed arrays); setup/offline code (the rig calibration), not the
 // tracker's hot path.
@@ -35,6 +44,12 @@ struct EdgeCentreConfig {
   double step_px = 0.25;              // sampling step along a ray
   double hidden_spread_widths = 1.0;  // rays rejected beside a rejected one, in edge widths
   bool grow_hidden = true;            // and further while the next ray's point is > 1 sigma inside
+  double axis_half_angle_deg = 45.0;  // rays left out on both sides of an occluder axis (EdgeAxis)
+};
+
+// An occluder axis in the image (any length; zero: none).
+struct EdgeAxis {
+  double x = 0.0, y = 0.0;
 };
 inline constexpr int kMaxEdgeRays = 256;
 
@@ -52,7 +67,7 @@ struct EdgeCentre {
 // centre); `radial_stretch`: a whole ball's image extent along that direction over its
 // extent across it (1: a circle).
 EdgeCentre edge_centre(const ImageView& img, const Blob& blob, double noise_dn, double radial_x,
-                       double radial_y, double radial_stretch,
-                       const EdgeCentreConfig& cfg = {}) noexcept;
+                       double radial_y, double radial_stretch, const EdgeCentreConfig& cfg = {},
+                       EdgeAxis axis = {}) noexcept;
 
 }  // namespace mocap::detect

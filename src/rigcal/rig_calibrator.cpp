@@ -54,7 +54,8 @@ double expected_roundness(const CameraModel& cam, const Vec2& px) noexcept {
 
 Expected<FrameBlobs> detect_recording(const std::string& dir, const detect::DetectorConfig& cfg,
                                       double min_roundness, const std::vector<CameraModel>* cams,
-                                      bool edge_centres) {
+                                      bool edge_centres, const WandSpec* wand,
+                                      const WandLabelConfig& label) {
   auto rec = Recording::open(dir);
   if (!rec) return rec.error();
   const std::size_t C = rec->rig().cameras.size();
@@ -73,26 +74,58 @@ Expected<FrameBlobs> detect_recording(const std::string& dir, const detect::Dete
   }
   detect::BlobList list = det[0].make_blob_list();
   FrameBlobs out(rec->frames().size(), std::vector<std::vector<Vec2>>(C));
+  std::vector<const detect::Blob*> kept;
+  std::vector<bool> on_wand;
+  std::vector<Vec2> scaled;
+  std::vector<std::size_t> index;
+  std::vector<int> order;
+  const detect::EdgeCentreConfig edge_cfg{};
   for (std::size_t f = 0; f < rec->frames().size(); ++f) {
     for (std::size_t c = 0; c < C; ++c) {
       auto r = rec->load_frame(static_cast<int>(c), rec->frames()[f].frame, img[c]);
       if (!r) return r.error();
       if (*r == FrameLoad::kMissing) continue;
       det[c].detect(img[c].view(), list);
+      const CameraModel& cam = cams ? (*cams)[c] : rec->rig().cameras[c];
+      kept.clear();
       for (const detect::Blob& b : list) {
         if (b.has(detect::kBlobTouchesBorder) || b.has(detect::kBlobMerged) ||
             b.has(detect::kBlobSplit))
           continue;
-        Vec2 px(b.x_px, b.y_px);
-        const CameraModel& cam = cams ? (*cams)[c] : rec->rig().cameras[c];
+        const Vec2 px(b.x_px, b.y_px);
         if (min_roundness > 0.0 &&
             static_cast<double>(b.roundness) < min_roundness * expected_roundness(cam, px))
           continue;
+        kept.push_back(&b);
+      }
+      // The wand's axis in this image, where the labeller finds the wand on the
+      // centroids: its balls' rims along the axis are left out of the edge fit.
+      detect::EdgeAxis axis;
+      on_wand.assign(kept.size(), false);
+      if (edge_centres && wand) {
+        scaled.clear();
+        index.clear();
+        for (std::size_t i = 0; i < kept.size(); ++i) {
+          Vec2 xn;
+          if (!undistort_pixel(cam, Vec2(kept[i]->x_px, kept[i]->y_px), xn)) continue;
+          scaled.push_back(to_scaled(cam, xn));
+          index.push_back(i);
+        }
+        if (label_wand(*wand, label, scaled, order) == LabelStatus::kOk) {
+          const detect::Blob& a = *kept[index[static_cast<std::size_t>(order.front())]];
+          const detect::Blob& z = *kept[index[static_cast<std::size_t>(order.back())]];
+          axis = {z.x_px - a.x_px, z.y_px - a.y_px};
+          for (int i : order) on_wand[index[static_cast<std::size_t>(i)]] = true;
+        }
+      }
+      for (std::size_t i = 0; i < kept.size(); ++i) {
+        const detect::Blob& b = *kept[i];
+        Vec2 px(b.x_px, b.y_px);
         if (edge_centres) {
           const Vec2 radial = px - Vec2(cam.cx, cam.cy);
-          const detect::EdgeCentre e =
-              detect::edge_centre(img[c].view(), b, list.levels().noise_dn, radial.x(), radial.y(),
-                                  expected_radial_stretch(cam, px));
+          const detect::EdgeCentre e = detect::edge_centre(
+              img[c].view(), b, list.levels().noise_dn, radial.x(), radial.y(),
+              expected_radial_stretch(cam, px), edge_cfg, on_wand[i] ? axis : detect::EdgeAxis{});
           if (e.ok) px = Vec2(e.x_px, e.y_px);
         }
         out[f][c].push_back(px);

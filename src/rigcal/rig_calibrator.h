@@ -106,11 +106,14 @@ Expected<void> check_camera_count(std::size_t cameras, const std::string& record
 // edge_centres: each kept blob's centre is its silhouette edge's (detect/edge_centre.h,
 // with the shape a whole ball has there): a wand's rod hides a notch of each ball's rim
 // and biases the intensity centroid along the wand; the centroid stays where the edge
-// fit fails.
+// fit fails. wand (with label): the wand is labelled on the centroids of each image, and
+// its balls' edge fits leave out the rim along the wand's axis (rod and handle), where a
+// hidden part too faint to reject still biases the edge (EdgeAxis); null: no axis.
 Expected<FrameBlobs> detect_recording(const std::string& dir, const detect::DetectorConfig& cfg,
                                       double min_roundness = 0.0,
                                       const std::vector<CameraModel>* cams = nullptr,
-                                      bool edge_centres = false);
+                                      bool edge_centres = false, const WandSpec* wand = nullptr,
+                                      const WandLabelConfig& label = {});
 
 // Minor/major axis ratio of a small ball's image centred at pixel px (first order:
 // perspective stretch 1/cos(off-axis angle) and the distortion's radial/tangential
