@@ -10,25 +10,25 @@
 namespace mocap::detect {
 namespace {
 
-double pixel(const ImageView& img, int x, int y) noexcept {
+double edge_pixel_dn(const ImageView& img, int x, int y) noexcept {
   return img.format == PixelFormat::kMono8 ? static_cast<double>(img.row8(y)[x])
                                            : static_cast<double>(img.row16(y)[x]);
 }
 
 // Bilinear sample at (x, y); false outside the image's interpolable area.
-bool sample(const ImageView& img, double x, double y, double& v) noexcept {
+bool sample_bilinear(const ImageView& img, double x, double y, double& v) noexcept {
   if (!(x >= 0.0 && y >= 0.0 && x <= img.width - 1.0 && y <= img.height - 1.0)) return false;
   const int x0 = std::min(static_cast<int>(x), img.width - 2);
   const int y0 = std::min(static_cast<int>(y), img.height - 2);
   const double fx = x - x0, fy = y - y0;
-  v = (1.0 - fy) * ((1.0 - fx) * pixel(img, x0, y0) + fx * pixel(img, x0 + 1, y0)) +
-      fy * ((1.0 - fx) * pixel(img, x0, y0 + 1) + fx * pixel(img, x0 + 1, y0 + 1));
+  v = (1.0 - fy) * ((1.0 - fx) * edge_pixel_dn(img, x0, y0) + fx * edge_pixel_dn(img, x0 + 1, y0)) +
+      fy * ((1.0 - fx) * edge_pixel_dn(img, x0, y0 + 1) + fx * edge_pixel_dn(img, x0 + 1, y0 + 1));
   return true;
 }
 
 // Solves the symmetric 3x3 system A p = b (Gaussian elimination, partial pivoting).
-bool solve3(std::array<std::array<double, 3>, 3> a, std::array<double, 3> b,
-            std::array<double, 3>& p) noexcept {
+bool solve_3x3(std::array<std::array<double, 3>, 3> a, std::array<double, 3> b,
+               std::array<double, 3>& p) noexcept {
   for (int c = 0; c < 3; ++c) {
     int piv = c;
     for (int r = c + 1; r < 3; ++r)
@@ -50,7 +50,7 @@ bool solve3(std::array<std::array<double, 3>, 3> a, std::array<double, 3> b,
   return true;
 }
 
-struct Pt {
+struct EdgePoint {
   double x, y;   // unstretched frame, relative to the blob's centroid
   double sigma;  // edge position noise (px)
   int ray;       // index of the ray (angular order)
@@ -74,16 +74,16 @@ EdgeCentre edge_centre(const ImageView& img, const Blob& blob, double noise_dn, 
   const double r_max = 0.5 * std::max(blob.x_max - blob.x_min, blob.y_max - blob.y_min) + 3.0;
   const double step = std::clamp(cfg.step_px, 0.05, 1.0);
 
-  std::array<Pt, kMaxEdgeRays> pts{};
+  std::array<EdgePoint, kMaxEdgeRays> pts{};
   int n = 0;
   for (int k = 0; k < rays; ++k) {
     const double a = 2.0 * M_PI * k / rays;
     const double dx = std::cos(a), dy = std::sin(a);
     double prev = 0.0;
-    if (!sample(img, blob.x_px, blob.y_px, prev) || prev < level) continue;
+    if (!sample_bilinear(img, blob.x_px, blob.y_px, prev) || prev < level) continue;
     for (double r = step; r <= r_max; r += step) {
       double v = 0.0;
-      if (!sample(img, blob.x_px + r * dx, blob.y_px + r * dy, v)) break;
+      if (!sample_bilinear(img, blob.x_px + r * dx, blob.y_px + r * dy, v)) break;
       if (v < level) {
         const double t = (prev - level) / (prev - v);  // in (0, 1]
         const double re = r - step + t * step;
@@ -112,7 +112,7 @@ EdgeCentre edge_centre(const ImageView& img, const Blob& blob, double noise_dn, 
       used_rays += std::fabs(std::cos(a) * ax + std::sin(a) * ay) > cos_half ? 0 : 1;
     }
     for (int i = 0; i < n; ++i) {
-      const Pt& q = pts[static_cast<std::size_t>(i)];
+      const EdgePoint& q = pts[static_cast<std::size_t>(i)];
       const double a = 2.0 * M_PI * q.ray / rays;
       if (std::fabs(std::cos(a) * ax + std::sin(a) * ay) > cos_half) continue;
       pts[static_cast<std::size_t>(kept++)] = q;
@@ -128,14 +128,14 @@ EdgeCentre edge_centre(const ImageView& img, const Blob& blob, double noise_dn, 
   std::array<std::array<double, 3>, 3> A{};
   std::array<double, 3> b{}, p{};
   for (int i = 0; i < n; ++i) {
-    const Pt& q = pts[static_cast<std::size_t>(i)];
+    const EdgePoint& q = pts[static_cast<std::size_t>(i)];
     const double row[3] = {q.x, q.y, 1.0}, rhs = -(q.x * q.x + q.y * q.y);
     for (int r = 0; r < 3; ++r) {
       for (int c = 0; c < 3; ++c) A[r][c] += row[r] * row[c];
       b[r] += row[r] * rhs;
     }
   }
-  if (!solve3(A, b, p)) return out;
+  if (!solve_3x3(A, b, p)) return out;
   double cx = -0.5 * p[0], cy = -0.5 * p[1];
   double rad2 = cx * cx + cy * cy - p[2];
   if (!(rad2 > 0.0)) return out;
@@ -147,7 +147,7 @@ EdgeCentre edge_centre(const ImageView& img, const Blob& blob, double noise_dn, 
   for (int iter = 0; iter < 8; ++iter) {
     // Robust scale: the median edge noise, or the points' own spread (MAD), the larger.
     for (int i = 0; i < n; ++i) {
-      const Pt& q = pts[static_cast<std::size_t>(i)];
+      const EdgePoint& q = pts[static_cast<std::size_t>(i)];
       abs_res[static_cast<std::size_t>(i)] = std::fabs(std::hypot(q.x - cx, q.y - cy) - rad);
       sig[static_cast<std::size_t>(i)] = q.sigma;
     }
@@ -165,7 +165,7 @@ EdgeCentre edge_centre(const ImageView& img, const Blob& blob, double noise_dn, 
                                                       rays / (2.0 * M_PI * std::max(rad, 0.5)))));
     std::array<bool, kMaxEdgeRays> hidden{};
     for (int i = 0; i < n; ++i) {
-      Pt& q = pts[static_cast<std::size_t>(i)];
+      EdgePoint& q = pts[static_cast<std::size_t>(i)];
       const double e = std::hypot(q.x - cx, q.y - cy) - rad;
       q.inlier = std::fabs(e) <= cfg.inlier_sigmas * std::max(scale, q.sigma);
       if (!q.inlier) {
@@ -178,7 +178,7 @@ EdgeCentre edge_centre(const ImageView& img, const Blob& blob, double noise_dn, 
     for (bool grew = cfg.grow_hidden; grew;) {
       grew = false;
       for (int i = 0; i < n; ++i) {
-        const Pt& q = pts[static_cast<std::size_t>(i)];
+        const EdgePoint& q = pts[static_cast<std::size_t>(i)];
         if (hidden[static_cast<std::size_t>(q.ray)]) continue;
         const bool beside = hidden[static_cast<std::size_t>((q.ray + 1) % rays)] ||
                             hidden[static_cast<std::size_t>((q.ray + rays - 1) % rays)];
@@ -191,7 +191,7 @@ EdgeCentre edge_centre(const ImageView& img, const Blob& blob, double noise_dn, 
     }
     inl = 0;
     for (int i = 0; i < n; ++i) {
-      Pt& q = pts[static_cast<std::size_t>(i)];
+      EdgePoint& q = pts[static_cast<std::size_t>(i)];
       q.inlier = q.inlier && !hidden[static_cast<std::size_t>(q.ray)];
       inl += q.inlier ? 1 : 0;
     }
@@ -200,7 +200,7 @@ EdgeCentre edge_centre(const ImageView& img, const Blob& blob, double noise_dn, 
     std::array<std::array<double, 3>, 3> H{};
     std::array<double, 3> g{}, d{};
     for (int i = 0; i < n; ++i) {
-      const Pt& q = pts[static_cast<std::size_t>(i)];
+      const EdgePoint& q = pts[static_cast<std::size_t>(i)];
       if (!q.inlier) continue;
       const double dist = std::max(std::hypot(q.x - cx, q.y - cy), 1e-9);
       const double e = dist - rad;
@@ -210,7 +210,7 @@ EdgeCentre edge_centre(const ImageView& img, const Blob& blob, double noise_dn, 
         g[r] -= J[r] * e;
       }
     }
-    if (!solve3(H, g, d)) return out;
+    if (!solve_3x3(H, g, d)) return out;
     cx += d[0];
     cy += d[1];
     rad += d[2];
@@ -219,7 +219,7 @@ EdgeCentre edge_centre(const ImageView& img, const Blob& blob, double noise_dn, 
   }
   double ss = 0.0;
   for (int i = 0; i < n; ++i) {
-    const Pt& q = pts[static_cast<std::size_t>(i)];
+    const EdgePoint& q = pts[static_cast<std::size_t>(i)];
     if (!q.inlier) continue;
     const double e = std::hypot(q.x - cx, q.y - cy) - rad;
     ss += e * e;
