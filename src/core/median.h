@@ -13,12 +13,18 @@
 
 namespace mocap {
 
+// Of the first n values at v (reordered; n > 0): for fixed arrays, no allocation.
+template <class T>
+T median_in_place(T* v, std::size_t n) noexcept {
+  T* mid = v + n / 2;
+  std::nth_element(v, mid, v + n);
+  return *mid;
+}
+
 // Reorders v; v must not be empty.
 template <class T>
 T median_in_place(std::vector<T>& v) {
-  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  return *mid;
+  return median_in_place(v.data(), v.size());
 }
 
 // Componentwise median of positions; pts must not be empty.

@@ -1,11 +1,14 @@
 // Design: see edge_centre.h. The circle fit is Kasa's algebraic fit (a 3x3 linear
-// system) for the start, then Gauss-Newton on the geometric distance over the inliers,
+// system, Eigen's LU) for the start, then Gauss-Newton on the geometric distance over the inliers,
 // with the inlier set re-chosen after each step from the current residuals.
 #include "detect/edge_centre.h"
 
+#include <Eigen/LU>
 #include <algorithm>
 #include <array>
 #include <cmath>
+
+#include "core/median.h"
 
 namespace mocap::detect {
 namespace {
@@ -23,30 +26,6 @@ bool sample_bilinear(const ImageView& img, double x, double y, double& v) noexce
   const double fx = x - x0, fy = y - y0;
   v = (1.0 - fy) * ((1.0 - fx) * edge_pixel_dn(img, x0, y0) + fx * edge_pixel_dn(img, x0 + 1, y0)) +
       fy * ((1.0 - fx) * edge_pixel_dn(img, x0, y0 + 1) + fx * edge_pixel_dn(img, x0 + 1, y0 + 1));
-  return true;
-}
-
-// Solves the symmetric 3x3 system A p = b (Gaussian elimination, partial pivoting).
-bool solve_3x3(std::array<std::array<double, 3>, 3> a, std::array<double, 3> b,
-               std::array<double, 3>& p) noexcept {
-  for (int c = 0; c < 3; ++c) {
-    int piv = c;
-    for (int r = c + 1; r < 3; ++r)
-      if (std::fabs(a[r][c]) > std::fabs(a[piv][c])) piv = r;
-    if (std::fabs(a[piv][c]) < 1e-12) return false;
-    std::swap(a[c], a[piv]);
-    std::swap(b[c], b[piv]);
-    for (int r = c + 1; r < 3; ++r) {
-      const double f = a[r][c] / a[c][c];
-      for (int k = c; k < 3; ++k) a[r][k] -= f * a[c][k];
-      b[r] -= f * b[c];
-    }
-  }
-  for (int r = 2; r >= 0; --r) {
-    double s = b[r];
-    for (int k = r + 1; k < 3; ++k) s -= a[r][k] * p[k];
-    p[r] = s / a[r][r];
-  }
   return true;
 }
 
@@ -74,11 +53,18 @@ EdgeCentre edge_centre(const ImageView& img, const Blob& blob, double noise_dn, 
   const double r_max = 0.5 * std::max(blob.x_max - blob.x_min, blob.y_max - blob.y_min) + 3.0;
   const double step = std::clamp(cfg.step_px, 0.05, 1.0);
 
+  // An occluder axis: the rays within axis_half_angle_deg of it are not used.
+  const double an = std::hypot(axis.x, axis.y);
+  const double ax = an > 0.0 ? axis.x / an : 0.0, ay = an > 0.0 ? axis.y / an : 0.0;
+  const double cos_half =
+      an > 0.0 ? std::cos(std::clamp(cfg.axis_half_angle_deg, 0.0, 70.0) * M_PI / 180.0) : 2.0;
   std::array<EdgePoint, kMaxEdgeRays> pts{};
-  int n = 0;
+  int n = 0, used_rays = 0;
   for (int k = 0; k < rays; ++k) {
     const double a = 2.0 * M_PI * k / rays;
     const double dx = std::cos(a), dy = std::sin(a);
+    if (std::fabs(dx * ax + dy * ay) > cos_half) continue;
+    ++used_rays;
     double prev = 0.0;
     if (!sample_bilinear(img, blob.x_px, blob.y_px, prev) || prev < level) continue;
     for (double r = step; r <= r_max; r += step) {
@@ -99,43 +85,23 @@ EdgeCentre edge_centre(const ImageView& img, const Blob& blob, double noise_dn, 
       prev = v;
     }
   }
-  // An occluder axis: leave out the rays within axis_half_angle_deg of it.
-  int used_rays = rays;
-  const double an = std::hypot(axis.x, axis.y);
-  if (an > 0.0 && n > 0) {
-    const double half = std::clamp(cfg.axis_half_angle_deg, 0.0, 70.0) * M_PI / 180.0;
-    const double ax = axis.x / an, ay = axis.y / an, cos_half = std::cos(half);
-    int kept = 0;
-    used_rays = 0;
-    for (int k = 0; k < rays; ++k) {
-      const double a = 2.0 * M_PI * k / rays;
-      used_rays += std::fabs(std::cos(a) * ax + std::sin(a) * ay) > cos_half ? 0 : 1;
-    }
-    for (int i = 0; i < n; ++i) {
-      const EdgePoint& q = pts[static_cast<std::size_t>(i)];
-      const double a = 2.0 * M_PI * q.ray / rays;
-      if (std::fabs(std::cos(a) * ax + std::sin(a) * ay) > cos_half) continue;
-      pts[static_cast<std::size_t>(kept++)] = q;
-    }
-    n = kept;
-  }
   out.edge_points = n;
   const int min_inliers =
       std::max(6, static_cast<int>(std::ceil(cfg.min_inlier_fraction * used_rays)));
   if (n < min_inliers) return out;
 
   // Kasa's fit over all points: x^2 + y^2 + D x + E y + F = 0.
-  std::array<std::array<double, 3>, 3> A{};
-  std::array<double, 3> b{}, p{};
+  Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d b = Eigen::Vector3d::Zero();
   for (int i = 0; i < n; ++i) {
     const EdgePoint& q = pts[static_cast<std::size_t>(i)];
-    const double row[3] = {q.x, q.y, 1.0}, rhs = -(q.x * q.x + q.y * q.y);
-    for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 3; ++c) A[r][c] += row[r] * row[c];
-      b[r] += row[r] * rhs;
-    }
+    const Eigen::Vector3d row(q.x, q.y, 1.0);
+    A += row * row.transpose();
+    b -= row * (q.x * q.x + q.y * q.y);
   }
-  if (!solve_3x3(A, b, p)) return out;
+  const Eigen::FullPivLU<Eigen::Matrix3d> kasa(A);
+  if (!kasa.isInvertible()) return out;
+  const Eigen::Vector3d p = kasa.solve(b);
   double cx = -0.5 * p[0], cy = -0.5 * p[1];
   double rad2 = cx * cx + cy * cy - p[2];
   if (!(rad2 > 0.0)) return out;
@@ -151,15 +117,13 @@ EdgeCentre edge_centre(const ImageView& img, const Blob& blob, double noise_dn, 
       abs_res[static_cast<std::size_t>(i)] = std::fabs(std::hypot(q.x - cx, q.y - cy) - rad);
       sig[static_cast<std::size_t>(i)] = q.sigma;
     }
-    const auto mid = static_cast<std::ptrdiff_t>(n / 2);
-    std::nth_element(abs_res.begin(), abs_res.begin() + mid, abs_res.begin() + n);
-    std::nth_element(sig.begin(), sig.begin() + mid, sig.begin() + n);
-    const double scale = std::max(1.4826 * abs_res[static_cast<std::size_t>(mid)],
-                                  sig[static_cast<std::size_t>(mid)]);
+    const auto un = static_cast<std::size_t>(n);
+    const double sigma_median = median_in_place(sig.data(), un);
+    const double scale = std::max(1.4826 * median_in_place(abs_res.data(), un), sigma_median);
     // A hidden part darkens the edge beyond itself by the blur: the rays within one edge
     // width (contrast / gradient, the median over the rays) of a rejected ray's edge point
     // along the rim are rejected with it.
-    const double edge_width_px = (peak - bg) * sig[static_cast<std::size_t>(mid)] / noise;
+    const double edge_width_px = (peak - bg) * sigma_median / noise;
     const int spread =
         std::min(rays / 4, static_cast<int>(std::ceil(cfg.hidden_spread_widths * edge_width_px *
                                                       rays / (2.0 * M_PI * std::max(rad, 0.5)))));
@@ -197,20 +161,19 @@ EdgeCentre edge_centre(const ImageView& img, const Blob& blob, double noise_dn, 
     }
     if (inl < min_inliers) return out;
     // One Gauss-Newton step on the geometric residual |q - c| - rad.
-    std::array<std::array<double, 3>, 3> H{};
-    std::array<double, 3> g{}, d{};
+    Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d g = Eigen::Vector3d::Zero();
     for (int i = 0; i < n; ++i) {
       const EdgePoint& q = pts[static_cast<std::size_t>(i)];
       if (!q.inlier) continue;
       const double dist = std::max(std::hypot(q.x - cx, q.y - cy), 1e-9);
-      const double e = dist - rad;
-      const double J[3] = {-(q.x - cx) / dist, -(q.y - cy) / dist, -1.0};
-      for (int r = 0; r < 3; ++r) {
-        for (int c = 0; c < 3; ++c) H[r][c] += J[r] * J[c];
-        g[r] -= J[r] * e;
-      }
+      const Eigen::Vector3d J(-(q.x - cx) / dist, -(q.y - cy) / dist, -1.0);
+      H += J * J.transpose();
+      g -= J * (dist - rad);
     }
-    if (!solve_3x3(H, g, d)) return out;
+    const Eigen::FullPivLU<Eigen::Matrix3d> step_lu(H);
+    if (!step_lu.isInvertible()) return out;
+    const Eigen::Vector3d d = step_lu.solve(g);
     cx += d[0];
     cy += d[1];
     rad += d[2];
