@@ -9,10 +9,18 @@
 //    triangulated with the true rig and with the calibrated rig (world = camera 0, so
 //    the truth is mapped with the true T_cam0_world); RMS 3D error of both;
 //  - ground frame: camera centres and rotations of the L-frame rig vs the truth.
+//  - every camera's pose relative to camera 0 (position of its centre in camera 0's
+//    frame, mm, and rotation, deg) against the truth: with 3..8 cameras (the simulator's
+//    built-in ring) the acceptance figure of the N-camera calibration.
 // Usage: rigcal_acceptance [frames] [seed] [intrinsics: true|perturbed] [mode: auto|refine|fixed]
+//                          [cameras: 2..8]
 // Environment: RIGCAL_MIN_ROUNDNESS (the blob filter), RIGCAL_CENTRES = centroid | edge |
 // axis (the wand balls' centres: intensity centroid, edge fit, edge fit without the rim
-// along the wand's axis; default axis, as mocap calibrate-rig).
+// along the wand's axis on the rod's side; default axis, as mocap calibrate-rig),
+// RIGCAL_ROD_CUT = degrees (that cut instead of the one chosen from the recording),
+// RIGCAL_TRUTH_NOISE = sigma px (the wand centres replaced by their true projections
+// plus Gaussian noise: the noise floor of the geometry and frame count).
+// Each run renders into its own folder under $TMPDIR (rigcal_acceptance_<seed>_<cameras>).
 #include <Eigen/Geometry>
 #include <chrono>
 #include <cmath>
@@ -20,13 +28,16 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "formats/rig_yaml.h"
 #include "rigcal/rig_calibrator.h"
 #include "sim/wand_sim.h"
 #include "stereo/two_view.h"
+#include "truth_markers.h"
 
 using namespace mocap;
 
@@ -34,33 +45,6 @@ namespace {
 
 double rot_deg(const Mat3& a, const Mat3& b) {
   return Eigen::AngleAxisd(a * b.transpose()).angle() * 180.0 / 3.14159265358979323846;
-}
-
-struct GtMarker {
-  int frame = 0;
-  Vec3 X = Vec3::Zero();
-  std::array<Vec2, 2> px;
-  bool vis = false;
-};
-
-std::vector<GtMarker> read_gt(const std::string& path) {
-  std::vector<GtMarker> out;
-  std::ifstream f(path);
-  std::string line;
-  std::getline(f, line);
-  while (std::getline(f, line)) {
-    GtMarker m;
-    int marker = 0, v0 = 0, v1 = 0;
-    double x, y, z, u0, w0, u1, w1;
-    if (std::sscanf(line.c_str(), "%d,%d,%lf,%lf,%lf,%lf,%lf,%d,%lf,%lf,%d", &m.frame, &marker, &x,
-                    &y, &z, &u0, &w0, &v0, &u1, &w1, &v1) != 11)
-      continue;
-    m.X = Vec3(x, y, z);
-    m.px = {Vec2(u0, w0), Vec2(u1, w1)};
-    m.vis = v0 == 1 && v1 == 1;
-    out.push_back(m);
-  }
-  return out;
 }
 
 bool nearest(const std::vector<Vec2>& blobs, const Vec2& p, Vec2& out) {
@@ -83,8 +67,14 @@ int main(int argc, char** argv) {
   const auto seed = static_cast<std::uint64_t>(argc > 2 ? std::atoll(argv[2]) : 1);
   const std::string intr_mode = argc > 3 ? argv[3] : "true";
   const std::string mode = argc > 4 ? argv[4] : "auto";
+  const int cameras = argc > 5 ? std::atoi(argv[5]) : 2;
+  if (cameras < 2 || cameras > 8) {
+    std::fprintf(stderr, "rigcal_acceptance: cameras must be 2..8, got %d\n", cameras);
+    return 1;
+  }
   const std::string dir =
-      (std::filesystem::temp_directory_path() / ("rigcal_acceptance_" + std::to_string(seed)))
+      (std::filesystem::temp_directory_path() /
+       ("rigcal_acceptance_" + std::to_string(seed) + "_" + std::to_string(cameras)))
           .string();
   std::filesystem::remove_all(dir);
   sim::SimOptions so;
@@ -92,6 +82,7 @@ int main(int argc, char** argv) {
   so.seed = seed;
   so.stray = 3;
   so.dropout = 0.02;
+  so.cameras = cameras;
   auto t0 = std::chrono::steady_clock::now();
   auto w = sim::write_calibration_recording(so, sim::CalibObjectKind::kWand, dir + "/wand");
   so.frames = 20;
@@ -104,7 +95,7 @@ int main(int argc, char** argv) {
   auto truth = load_rig(dir + "/wand/gt/rig_true.yaml");
   auto truth_l = load_rig(dir + "/lframe/gt/rig_lframe_true.yaml");
   if (!truth || !truth_l) return 1;
-  std::vector<CameraModel> intr = {truth->cameras[0], truth->cameras[1]};
+  std::vector<CameraModel> intr = truth->cameras;
   if (intr_mode == "perturbed") {
     intr[0].fx *= 1.004;
     intr[0].fy *= 1.004;
@@ -125,10 +116,31 @@ int main(int argc, char** argv) {
       std::getenv("RIGCAL_CENTRES") ? std::getenv("RIGCAL_CENTRES") : "axis";
   opt.edge_centres = centres != "centroid";
   const WandSpec wand = sim::default_calibration_objects().wand;
-  auto blobs =
-      rigcal::detect_recording(dir + "/wand", opt.detector, opt.min_roundness, &intr,
-                               opt.edge_centres, centres == "axis" ? &wand : nullptr, opt.label);
-  if (!blobs) return 1;
+  if (const char* r = std::getenv("RIGCAL_ROD_CUT")) opt.rod_cut_deg = std::atof(r);
+  auto detected =
+      rigcal::detect_recording(dir + "/wand", opt, &intr, centres == "axis" ? &wand : nullptr);
+  if (!detected) {
+    std::fprintf(stderr, "%s\n", detected.error().message.c_str());
+    return 1;
+  }
+  rigcal::FrameBlobs* blobs = &detected->blobs;
+  // RIGCAL_TRUTH_NOISE=sigma: every detected wand centre is replaced by its true
+  // projection plus Gaussian noise of sigma px per axis: what the geometry and the
+  // frames allow with unbiased centres of that precision.
+  if (const char* gn = std::getenv("RIGCAL_TRUTH_NOISE")) {
+    const double sg = std::atof(gn);
+    std::mt19937 rng(7);
+    std::normal_distribution<double> nd(0.0, sg);
+    for (const bench::TruthMarker& m :
+         bench::read_truth_markers(dir + "/wand/gt/markers.csv", cameras)) {
+      const auto fi = static_cast<std::size_t>(m.frame);
+      if (fi >= blobs->size()) continue;
+      for (std::size_t c = 0; c < m.px.size(); ++c) {
+        for (Vec2& b : (*blobs)[fi][c])
+          if ((b - m.px[c]).norm() < 1.5) b = m.px[c] + Vec2(nd(rng), nd(rng));
+      }
+    }
+  }
   auto t2 = std::chrono::steady_clock::now();
   auto res = rigcal::calibrate_from_blobs(*blobs, wand, intr, opt, dir + "/wand");
   if (!res) {
@@ -147,7 +159,7 @@ int main(int argc, char** argv) {
           1.0, T10_cal.translation().normalized().dot(T10_true.translation().normalized()))) *
       180.0 / 3.14159265358979323846;
   // 3D accuracy on the same recording.
-  const auto gt = read_gt(dir + "/wand/gt/markers.csv");
+  const auto gt = bench::read_truth_markers(dir + "/wand/gt/markers.csv", cameras);
   auto g_true = make_stereo_geometry(truth->cameras[0], truth->cameras[1]);
   auto g_cal = make_stereo_geometry(cal[0], cal[1]);
   if (!g_true || !g_cal) return 1;
@@ -155,8 +167,8 @@ int main(int argc, char** argv) {
   double ss_true = 0.0, ss_cal = 0.0;
   int n = 0;
   std::vector<Vec3> pts_cal, pts_gt;
-  for (const GtMarker& m : gt) {
-    if (!m.vis || m.frame >= static_cast<int>(blobs->size())) continue;
+  for (const bench::TruthMarker& m : gt) {
+    if (!m.alone[0] || !m.alone[1] || m.frame >= static_cast<int>(blobs->size())) continue;
     Vec2 b0, b1;
     const auto& fb = (*blobs)[static_cast<std::size_t>(m.frame)];
     if (!nearest(fb[0], m.px[0], b0) || !nearest(fb[1], m.px[1], b1)) continue;
@@ -191,7 +203,7 @@ int main(int argc, char** argv) {
   {
     std::vector<Vec3> ends;
     int last_frame = -1;
-    for (const GtMarker& m : gt) {
+    for (const bench::TruthMarker& m : gt) {
       if (m.frame != last_frame) ends.clear();
       last_frame = m.frame;
       Vec2 b0, b1;
@@ -214,18 +226,17 @@ int main(int argc, char** argv) {
   const double rms_true = std::sqrt(ss_true / std::max(1, n));
   const double rms_cal = std::sqrt(ss_cal / std::max(1, n));
   // Ground frame.
-  auto lb = rigcal::detect_recording(dir + "/lframe", opt.detector, opt.min_roundness, &intr,
-                                     opt.edge_centres);
+  auto lb = rigcal::detect_recording(dir + "/lframe", opt, &intr);
   if (!lb) return 1;
   rigcal::RigCalResult with_ground = *res;
-  if (auto r = rigcal::set_ground_frame(with_ground, *lb, sim::default_calibration_objects().lframe,
-                                        opt, dir + "/lframe");
+  if (auto r = rigcal::set_ground_frame(
+          with_ground, lb->blobs, sim::default_calibration_objects().lframe, opt, dir + "/lframe");
       !r) {
     std::fprintf(stderr, "%s\n", r.error().message.c_str());
     return 1;
   }
   double ground_pos = 0.0, ground_rot = 0.0;
-  for (std::size_t c = 0; c < 2; ++c) {
+  for (std::size_t c = 0; c < intr.size(); ++c) {
     ground_pos = std::max(
         ground_pos,
         (with_ground.cameras[c].center_world() - truth_l->cameras[c].center_world()).norm());
@@ -233,8 +244,22 @@ int main(int argc, char** argv) {
         ground_rot, rot_deg(with_ground.cameras[c].R_cam_world, truth_l->cameras[c].R_cam_world));
   }
   auto sec = [](auto a, auto b) { return std::chrono::duration<double>(b - a).count(); };
-  std::printf("frames %d seed %llu intrinsics %s mode %s\n", frames,
-              static_cast<unsigned long long>(seed), intr_mode.c_str(), mode.c_str());
+  std::printf("frames %d seed %llu intrinsics %s mode %s cameras %d centres %s\n", frames,
+              static_cast<unsigned long long>(seed), intr_mode.c_str(), mode.c_str(), cameras,
+              centres.c_str());
+  {
+    const rigcal::RodCutChoice& rc = detected->rod_cut;
+    std::printf(
+        "  wand centres: rod-side cut %.0f deg (%s), %d end-ball views, outer rim used in "
+        "%.0f %%; per cut: mean shift away from the rod (its standard error) / along-wand noise, "
+        "px:",
+        rc.cut_deg, rc.from_recording ? "chosen" : "fixed", rc.end_ball_views,
+        100.0 * rc.outer_rim_used);
+    for (std::size_t j = 0; j < rigcal::kRodCutsDeg.size(); ++j)
+      std::printf(" %.0f:%+.4f(%.4f)/%.3f", rigcal::kRodCutsDeg[j], rc.mean_shift_px[j],
+                  rc.standard_error_px[j], rc.along_sd_px[j]);
+    std::printf("\n");
+  }
   std::printf("  frames: wand in both %d, used %d; intrinsics refined: %s\n", res->frames_both,
               res->frames_used, res->intrinsics_refined ? "yes" : "no");
   std::printf(
@@ -254,6 +279,25 @@ int main(int argc, char** argv) {
                   cal[c].distortion[1] - truth->cameras[c].distortion[1]);
     }
   }
+  // Every camera's pose relative to camera 0.
+  double worst_mm = 0.0, worst_deg = 0.0;
+  for (std::size_t c = 1; c < cal.size(); ++c) {
+    const Iso3 T_c0_true =
+        truth->cameras[c].T_cam_world() * truth->cameras[0].T_cam_world().inverse();
+    const Iso3 T_c0_cal = cal[c].T_cam_world() * cal[0].T_cam_world().inverse();
+    const Vec3 C_true = T_c0_true.inverse().translation(), C_cal = T_c0_cal.inverse().translation();
+    const double pos_mm = (C_cal - C_true).norm();
+    const double along_mm = (C_cal - C_true).dot(C_true.normalized());
+    const double deg = rot_deg(T_c0_cal.linear(), T_c0_true.linear());
+    worst_mm = std::max(worst_mm, pos_mm);
+    worst_deg = std::max(worst_deg, deg);
+    std::printf(
+        "  %s relative to %s: position error %.4f mm (along the baseline %+.4f mm, "
+        "baseline %.0f mm), rotation error %.5f deg, reprojection RMS %.4f px\n",
+        cal[c].name.c_str(), cal[0].name.c_str(), pos_mm, along_mm, C_true.norm(), deg,
+        res->quality[c].reprojection_rms_px);
+  }
+  std::printf("  worst camera pose error %.4f mm, %.5f deg\n", worst_mm, worst_deg);
   std::printf(
       "  3D RMS error over %d marker views: true rig %.4f mm, calibrated rig %.4f mm "
       "(ratio %.3f)\n",

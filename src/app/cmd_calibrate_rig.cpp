@@ -29,6 +29,7 @@ struct RigArgs {
   std::string recording, wand, out, lframe, report, mode = "auto";
   std::vector<std::string> intrinsics;
   int min_frames = 30;
+  double rod_cut_deg = 0.0;  // 0: chosen from the recording
 };
 
 // The cameras' intrinsics (and maybe a pair's relative pose) from the --intrinsics
@@ -114,6 +115,7 @@ int run(const RigArgs& a) {
   if (a.wand.empty()) return fail("calibrate-rig: --wand: required with a wand recording");
   rigcal::RigCalOptions opt;
   opt.min_frames = a.min_frames;
+  opt.rod_cut_deg = a.rod_cut_deg;
   if (a.mode == "auto") {
     opt.intrinsics = rigcal::IntrinsicsMode::kAuto;
   } else if (a.mode == "refine") {
@@ -125,6 +127,12 @@ int run(const RigArgs& a) {
                 "'");
   }
   if (a.min_frames < 8) return fail("calibrate-rig: --min-frames: must be >= 8");
+  if (a.rod_cut_deg != 0.0 && !(a.rod_cut_deg >= rigcal::kRodCutsDeg.front() &&
+                                a.rod_cut_deg <= rigcal::kRodCutsDeg.back()))
+    return fail(
+        "calibrate-rig: --rod-cut: must be 20 to 60 degrees (or 0: chosen from the "
+        "recording), got " +
+        std::to_string(a.rod_cut_deg));
   auto objects = load_calibration_objects(a.wand);
   if (!objects) return fail(objects.error().message);
   if (!a.lframe.empty() && !objects->has_lframe)
@@ -154,16 +162,16 @@ int run(const RigArgs& a) {
       intr[c] = m;
     }
   }
-  auto blobs = rigcal::detect_recording(a.recording, opt.detector, opt.min_roundness, &intr,
-                                        opt.edge_centres, &objects->wand, opt.label);
-  if (!blobs) return fail(blobs.error().message);
-  auto result = rigcal::calibrate_from_blobs(*blobs, objects->wand, intr, opt, a.recording);
+  auto detected = rigcal::detect_recording(a.recording, opt, &intr, &objects->wand);
+  if (!detected) return fail(detected.error().message);
+  auto result =
+      rigcal::calibrate_from_blobs(detected->blobs, objects->wand, intr, opt, a.recording);
   if (!result) return fail(result.error().message);
+  result->wand_centres = detected->rod_cut;
   if (!a.lframe.empty()) {
-    auto lb = rigcal::detect_recording(a.lframe, opt.detector, opt.min_roundness, &intr,
-                                       opt.edge_centres);
+    auto lb = rigcal::detect_recording(a.lframe, opt, &intr);
     if (!lb) return fail(lb.error().message);
-    if (auto r = rigcal::set_ground_frame(*result, *lb, objects->lframe, opt, a.lframe); !r)
+    if (auto r = rigcal::set_ground_frame(*result, lb->blobs, objects->lframe, opt, a.lframe); !r)
       return fail(r.error().message);
   }
   Rig rig;
@@ -213,6 +221,9 @@ void register_calibrate_rig(CLI::App& app, int& exit_code) {
                   "auto (refine when the wand covered the images well), refine or fixed");
   cmd->add_option("--min-frames", args->min_frames,
                   "Fewest frames with the wand in two or more cameras (default 30)");
+  cmd->add_option("--rod-cut", args->rod_cut_deg,
+                  "Degrees of each wand ball's rim left out beside the rod (20..60); default: "
+                  "chosen from the recording");
   cmd->callback([args, &exit_code] { exit_code = run(*args); });
 }
 

@@ -1,5 +1,7 @@
 #include "camera/camera_model.h"
 
+#include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
 
 namespace mocap {
@@ -95,6 +97,71 @@ bool pixel_ray_world(const CameraModel& cam, const Vec2& px, Vec3& dir_world) no
   if (!undistort_pixel(cam, px, xn)) return false;
   dir_world = (cam.R_cam_world.transpose() * Vec3(xn.x(), xn.y(), 1.0)).normalized();
   return true;
+}
+
+namespace {
+
+// Where an edge fit finds the centre of the image of a ball whose centre projects to xc
+// (normalised undistorted) and whose tangent cone has half angle asin(sin_b). The
+// silhouette is an ellipse centred at xe with semi-axes a (radial, u) and b (across, v).
+// The lens maps it to x(phi) = d(xe) + J (a cos u + b sin v) + P cos^2 + Q cos sin +
+// R sin^2 (P, Q, R: its second differences over the semi-axes). An edge fit undoes the
+// expected radial stretch s = |J a u| / |J b v| and fits a circle: its centre is the
+// first Fourier harmonic of the radius, which takes the quadratic terms' constant part
+// and half of their second harmonic: along u 3/4 P + 1/4 R + s/4 Q (v component of Q),
+// across 1/4 P + 3/4 R + 1/(4 s) Q (u component). Normalised distorted coordinates.
+Vec2 ball_image_centre(const CameraModel& cam, const Vec2& xc, double sin_b) noexcept {
+  const double t = xc.norm();
+  const Vec2 u = t > 1e-12 ? Vec2(xc / t) : Vec2(1.0, 0.0);
+  const Vec2 v(-u.y(), u.x());
+  const double th = std::atan(t), beta = std::asin(std::clamp(sin_b, 0.0, 0.5));
+  const double t_plus = std::tan(th + beta), t_minus = std::tan(th - beta);
+  const Vec2 xe = u * (0.5 * (t_plus + t_minus));
+  const double a = 0.5 * (t_plus - t_minus);
+  const double cos_t = std::cos(th);
+  const double b = sin_b / std::sqrt(std::max(cos_t * cos_t - sin_b * sin_b, 1e-12));
+  auto d = [&](const Vec2& x) { return distort_normalized(cam, x); };
+  const Vec2 d0 = d(xe);
+  const Vec2 P = 0.5 * (d(xe + a * u) + d(xe - a * u) - 2.0 * d0);
+  const Vec2 R = 0.5 * (d(xe + b * v) + d(xe - b * v) - 2.0 * d0);
+  const Vec2 Q = 0.25 * (d(xe + a * u + b * v) - d(xe + a * u - b * v) - d(xe - a * u + b * v) +
+                         d(xe - a * u - b * v));
+  const Eigen::Matrix2d J = distort_jacobian(cam, xe);
+  const double s = (J * u).norm() * a / std::max((J * v).norm() * b, 1e-300);
+  const double along = 0.75 * P.dot(u) + 0.25 * R.dot(u) + 0.25 * s * Q.dot(v);
+  const double across = 0.25 * P.dot(v) + 0.75 * R.dot(v) + 0.25 / s * Q.dot(u);
+  return d0 + along * u + across * v;
+}
+
+}  // namespace
+
+bool ball_centre_pixel(const CameraModel& cam, const Vec2& silhouette_px, double radius_px,
+                       Vec2& centre_px) noexcept {
+  centre_px = silhouette_px;
+  Vec2 xm;
+  if (!(radius_px > 0.0) || !(cam.fx > 0.0) || !(cam.fy > 0.0) ||
+      !undistort_pixel(cam, silhouette_px, xm))
+    return false;
+  const Vec2 m(silhouette_px.x() - cam.cx, silhouette_px.y() - cam.cy);
+  const Vec2 m_norm(m.x() / cam.fx, m.y() / cam.fy);  // normalised distorted
+  // The half width across the radial direction in normalised undistorted units: the
+  // pixels over the focal length and the lens's local magnification across.
+  const double tm = xm.norm();
+  const Vec2 v = tm > 1e-12 ? Vec2(-xm.y() / tm, xm.x() / tm) : Vec2(0.0, 1.0);
+  const Vec2 jv = distort_jacobian(cam, xm) * v;
+  const double b_meas = radius_px / Vec2(cam.fx * jv.x(), cam.fy * jv.y()).norm();
+  // Fixed point on the ball's centre xc (the correction is second order in beta).
+  Vec2 xc = xm;
+  for (int round = 0; round < 4; ++round) {
+    const double cos_t = 1.0 / std::sqrt(1.0 + xc.squaredNorm());
+    const double sin_b = b_meas * cos_t / std::sqrt(1.0 + b_meas * b_meas);
+    const Vec2 predicted = ball_image_centre(cam, xc, sin_b);
+    // Move xc by the mismatch, mapped back through the lens's local Jacobian.
+    const Eigen::Matrix2d J = distort_jacobian(cam, xc);
+    xc += J.inverse() * (m_norm - predicted);
+  }
+  centre_px = normalized_to_pixel(cam, xc);
+  return std::isfinite(centre_px.x()) && std::isfinite(centre_px.y());
 }
 
 }  // namespace mocap

@@ -9,6 +9,7 @@
 #include "formats/recording.h"
 #include "rigcal/pairwise_init.h"
 #include "rigcal/rig_quality.h"
+#include "rigcal/wand_centres.h"
 #include "stereo/two_view.h"
 
 namespace mocap::rigcal {
@@ -52,10 +53,9 @@ double expected_roundness(const CameraModel& cam, const Vec2& px) noexcept {
   return s > 1.0 ? 1.0 / s : s;
 }
 
-Expected<FrameBlobs> detect_recording(const std::string& dir, const detect::DetectorConfig& cfg,
-                                      double min_roundness, const std::vector<CameraModel>* cams,
-                                      bool edge_centres, const WandSpec* wand,
-                                      const WandLabelConfig& label) {
+Expected<DetectedRecording> detect_recording(const std::string& dir, const RigCalOptions& opt,
+                                             const std::vector<CameraModel>* cams,
+                                             const WandSpec* wand) {
   auto rec = Recording::open(dir);
   if (!rec) return rec.error();
   const std::size_t C = rec->rig().cameras.size();
@@ -67,19 +67,22 @@ Expected<FrameBlobs> detect_recording(const std::string& dir, const detect::Dete
   std::vector<Image> img(C);
   std::vector<detect::BlobDetector> det;
   for (std::size_t c = 0; c < C; ++c) {
-    auto d = detect::BlobDetector::create(cfg, rec->rig().cameras[c].width,
+    auto d = detect::BlobDetector::create(opt.detector, rec->rig().cameras[c].width,
                                           rec->rig().cameras[c].height);
     if (!d) return d.error();
     det.push_back(std::move(*d));
   }
   detect::BlobList list = det[0].make_blob_list();
-  FrameBlobs out(rec->frames().size(), std::vector<std::vector<Vec2>>(C));
+  DetectedRecording out;
+  out.blobs.assign(rec->frames().size(), std::vector<std::vector<Vec2>>(C));
+  WandCentres wand_centres;
   std::vector<const detect::Blob*> kept;
-  std::vector<bool> on_wand;
+  std::vector<int> role;  // per kept blob: -1 not on the wand, else its WandBallRole
   std::vector<Vec2> scaled;
   std::vector<std::size_t> index;
   std::vector<int> order;
   const detect::EdgeCentreConfig edge_cfg{};
+  detect::EdgeSamples samples;
   for (std::size_t f = 0; f < rec->frames().size(); ++f) {
     for (std::size_t c = 0; c < C; ++c) {
       auto r = rec->load_frame(static_cast<int>(c), rec->frames()[f].frame, img[c]);
@@ -93,16 +96,16 @@ Expected<FrameBlobs> detect_recording(const std::string& dir, const detect::Dete
             b.has(detect::kBlobSplit))
           continue;
         const Vec2 px(b.x_px, b.y_px);
-        if (min_roundness > 0.0 &&
-            static_cast<double>(b.roundness) < min_roundness * expected_roundness(cam, px))
+        if (opt.min_roundness > 0.0 &&
+            static_cast<double>(b.roundness) < opt.min_roundness * expected_roundness(cam, px))
           continue;
         kept.push_back(&b);
       }
-      // The wand's axis in this image, where the labeller finds the wand on the
-      // centroids: its balls' rims along the axis are left out of the edge fit.
-      detect::EdgeAxis axis;
-      on_wand.assign(kept.size(), false);
-      if (edge_centres && wand) {
+      // The wand in this image, labelled on the centroids: its balls' centres come from
+      // WandCentres (the rim along the wand's axis left out on the rod's side).
+      Vec2 axis = Vec2::Zero();
+      role.assign(kept.size(), -1);
+      if (opt.edge_centres && wand) {
         scaled.clear();
         index.clear();
         for (std::size_t i = 0; i < kept.size(); ++i) {
@@ -111,26 +114,40 @@ Expected<FrameBlobs> detect_recording(const std::string& dir, const detect::Dete
           scaled.push_back(to_scaled(cam, xn));
           index.push_back(i);
         }
-        if (label_wand(*wand, label, scaled, order) == LabelStatus::kOk) {
+        if (label_wand(*wand, opt.label, scaled, order) == LabelStatus::kOk) {
           const detect::Blob& a = *kept[index[static_cast<std::size_t>(order.front())]];
           const detect::Blob& z = *kept[index[static_cast<std::size_t>(order.back())]];
-          axis = {z.x_px - a.x_px, z.y_px - a.y_px};
-          for (int i : order) on_wand[index[static_cast<std::size_t>(i)]] = true;
+          axis = Vec2(z.x_px - a.x_px, z.y_px - a.y_px);
+          for (std::size_t k = 0; k < order.size(); ++k) {
+            const WandBallRole w = k == 0                  ? WandBallRole::kFirst
+                                   : k + 1 == order.size() ? WandBallRole::kLast
+                                                           : WandBallRole::kMiddle;
+            role[index[static_cast<std::size_t>(order[k])]] = static_cast<int>(w);
+          }
         }
       }
+      auto& centres = out.blobs[f][c];
       for (std::size_t i = 0; i < kept.size(); ++i) {
         const detect::Blob& b = *kept[i];
-        Vec2 px(b.x_px, b.y_px);
-        if (edge_centres) {
-          const Vec2 radial = px - Vec2(cam.cx, cam.cy);
-          const detect::EdgeCentre e = detect::edge_centre(
-              img[c].view(), b, list.levels().noise_dn, radial.x(), radial.y(),
-              expected_radial_stretch(cam, px), edge_cfg, on_wand[i] ? axis : detect::EdgeAxis{});
-          if (e.ok) px = Vec2(e.x_px, e.y_px);
-        }
-        out[f][c].push_back(px);
+        centres.emplace_back(b.x_px, b.y_px);
+        if (!opt.edge_centres) continue;
+        const Vec2 radial = centres.back() - Vec2(cam.cx, cam.cy);
+        if (!detect::sample_edge(img[c].view(), b, list.levels().noise_dn, radial.x(), radial.y(),
+                                 expected_radial_stretch(cam, centres.back()), edge_cfg, samples))
+          continue;  // the centroid
+        if (role[i] >= 0 && wand_centres.add(samples, cam, static_cast<WandBallRole>(role[i]), axis,
+                                             f, c, centres.size() - 1))
+          continue;  // WandCentres::apply() writes it
+        const detect::EdgeCentre e = detect::fit_edge_centre(samples, edge_cfg);
+        if (!e.ok) continue;
+        Vec2 ball;
+        if (ball_centre_pixel(cam, Vec2(e.x_px, e.y_px), e.radius_px, ball)) centres.back() = ball;
       }
     }
+  }
+  if (opt.edge_centres && wand) {
+    out.rod_cut = wand_centres.choose(opt.rod_cut_deg);
+    wand_centres.apply(out.rod_cut, out.blobs);
   }
   return out;
 }

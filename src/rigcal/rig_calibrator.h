@@ -30,6 +30,7 @@
 #include "formats/wand_yaml.h"
 #include "rigcal/bundle.h"
 #include "rigcal/ground_frame.h"
+#include "rigcal/wand_centres.h"
 #include "rigcal/wand_labeler.h"
 
 namespace mocap::rigcal {
@@ -43,6 +44,8 @@ struct RigCalOptions {
   detect::DetectorConfig detector{};
   double min_roundness = 0.95;  // of the expected roundness (detect_recording)
   bool edge_centres = true;     // balls' centres from their edges (detect_recording)
+  double rod_cut_deg = 0.0;     // the wand rim left out on the rod's side: 0 = chosen from
+                                // the recording (wand_centres.h), > 0 = this (20..60)
   WandLabelConfig label{};
   IntrinsicsMode intrinsics = IntrinsicsMode::kAuto;
   int min_frames = 30;            // fewer frames with the wand in >= 2 cameras: error; also the
@@ -90,30 +93,39 @@ struct RigCalResult {
   bool has_ground = false;
   GroundFrameResult ground;
   std::vector<std::string> warnings;
+  // How the wand balls' centres were found (set by the caller from detect_recording;
+  // written to the report when end_ball_views > 0).
+  RodCutChoice wand_centres;
 };
 
 // A rig calibration needs kMinRigCameras..kMaxRigCameras cameras; else the one-line
 // error "<recording>/rig.yaml: cameras: ...".
 Expected<void> check_camera_count(std::size_t cameras, const std::string& recording);
 
+// The blobs of a recording (detect_recording) and, for a wand, how its balls' centres
+// were found.
+struct DetectedRecording {
+  FrameBlobs blobs;
+  RodCutChoice rod_cut;  // end_ball_views = 0 without a wand or edge centres
+};
+
 // Detects blobs in every frame of a recording (every camera of its rig.yaml: 2..8, else
-// a one-line error naming the rig.yaml). Blobs that are merged,
-// split or touch the border are left out, and so are blobs less round than
-// min_roundness x the roundness a whole ball has at that place in the image (a ball's
-// image is an ellipse stretched radially by perspective and squeezed by barrel
-// distortion, expected_roundness()): a partly hidden marker has a biased centre.
-// cams: the intrinsics for that expectation (the recording's rig.yaml when null).
-// edge_centres: each kept blob's centre is its silhouette edge's (detect/edge_centre.h,
-// with the shape a whole ball has there): a wand's rod hides a notch of each ball's rim
-// and biases the intensity centroid along the wand; the centroid stays where the edge
-// fit fails. wand (with label): the wand is labelled on the centroids of each image, and
-// its balls' edge fits leave out the rim along the wand's axis (rod and handle), where a
-// hidden part too faint to reject still biases the edge (EdgeAxis); null: no axis.
-Expected<FrameBlobs> detect_recording(const std::string& dir, const detect::DetectorConfig& cfg,
-                                      double min_roundness = 0.0,
-                                      const std::vector<CameraModel>* cams = nullptr,
-                                      bool edge_centres = false, const WandSpec* wand = nullptr,
-                                      const WandLabelConfig& label = {});
+// a one-line error naming the rig.yaml). Blobs that are merged, split or touch the
+// border are left out, and so are blobs less round than options.min_roundness x the
+// roundness a whole ball has at that place in the image (a ball's image is an ellipse
+// stretched radially by perspective and squeezed by barrel distortion,
+// expected_roundness()): a partly hidden marker has a biased centre. cams: the
+// intrinsics for that expectation (the recording's rig.yaml when null).
+// options.edge_centres: each kept blob's centre is its silhouette edge's
+// (detect/edge_centre.h, with the shape a whole ball has there), moved to the
+// projection of the ball's centre (ball_centre_pixel); the centroid stays where the
+// edge fit fails. wand (with options.label): the wand is labelled on the centroids of
+// each image and its balls' centres come from WandCentres (wand_centres.h: the rim
+// along the axis left out on the rod's side, the cut chosen from the recording unless
+// options.rod_cut_deg fixes it); null: no axis (an L-frame).
+Expected<DetectedRecording> detect_recording(const std::string& dir, const RigCalOptions& options,
+                                             const std::vector<CameraModel>* cams = nullptr,
+                                             const WandSpec* wand = nullptr);
 
 // Minor/major axis ratio of a small ball's image centred at pixel px (first order:
 // perspective stretch 1/cos(off-axis angle) and the distortion's radial/tangential

@@ -139,6 +139,36 @@ inline SynthImage render(const std::vector<Spot>& spots, const SynthParams& p) {
   return quantise(render_light(spots, p), p);
 }
 
+// A ball's image: a disc of radius r at (x, y) and amplitude amp, with an optional dark
+// rod: a bar of width rod_w whose axis leaves the disc's centre at angle phi (image x
+// towards y), hiding the disc from 0.6 r outwards (a wand's rod entering the ball).
+// Blur, noise and quantisation as p says.
+inline SynthImage ball_with_rod(const SynthParams& p, double x, double y, double r, double amp,
+                                double rod_w, double phi) {
+  std::vector<double> f(static_cast<std::size_t>(p.width) * p.height, 0.0);
+  const Spot disc{x, y, r, amp};
+  const double ca = std::cos(phi), sa = std::sin(phi);
+  const Spot rod{x + ca * (0.6 * r + 10.0),
+                 y + sa * (0.6 * r + 10.0),
+                 10.0,
+                 1.0,
+                 rod_w > 0.0 ? 0.5 * rod_w / 10.0 : 1.0,
+                 phi};
+  const int reach = static_cast<int>(std::ceil(r)) + 2;
+  for (int py = std::max(0, static_cast<int>(y) - reach);
+       py <= std::min(p.height - 1, static_cast<int>(y) + reach); ++py) {
+    for (int px = std::max(0, static_cast<int>(x) - reach);
+         px <= std::min(p.width - 1, static_cast<int>(x) + reach); ++px) {
+      const double hidden = rod_w > 0.0 ? coverage(rod, px, py) : 0.0;
+      f[static_cast<std::size_t>(py) * p.width + px] =
+          disc.amplitude_dn * coverage(disc, px, py) * (1.0 - hidden);
+    }
+  }
+  blur(f, p);
+  for (double& v : f) v += p.background_dn;
+  return quantise(f, p);
+}
+
 // Random well-separated discs (centres at least min_gap_px apart, inside the margin).
 inline std::vector<Spot> random_discs(int n, const SynthParams& p, double r_min, double r_max,
                                       double amp_min, double amp_max, double min_gap_px,

@@ -18,29 +18,9 @@ namespace {
 using test::Spot;
 using test::SynthParams;
 
-// A disc of radius r at (x, y), with an optional dark rod: a bar of width rod_w whose
-// axis leaves the disc's centre at angle phi, covering the rim from 0.6 r outwards.
 test::SynthImage ball_image(const SynthParams& p, double x, double y, double r, double rod_w,
                             double phi) {
-  std::vector<double> f(static_cast<std::size_t>(p.width) * p.height, 0.0);
-  const Spot disc{x, y, r, 200.0};
-  const double ca = std::cos(phi), sa = std::sin(phi);
-  const Spot rod{x + ca * (0.6 * r + 10.0),
-                 y + sa * (0.6 * r + 10.0),
-                 10.0,
-                 1.0,
-                 rod_w > 0.0 ? 0.5 * rod_w / 10.0 : 1.0,
-                 phi};
-  for (int py = 0; py < p.height; ++py) {
-    for (int px = 0; px < p.width; ++px) {
-      const double hidden = rod_w > 0.0 ? test::coverage(rod, px, py) : 0.0;
-      f[static_cast<std::size_t>(py) * p.width + px] =
-          disc.amplitude_dn * test::coverage(disc, px, py) * (1.0 - hidden);
-    }
-  }
-  test::blur(f, p);
-  for (double& v : f) v += p.background_dn;
-  return test::quantise(f, p);
+  return test::ball_with_rod(p, x, y, r, 200.0, rod_w, phi);
 }
 
 SynthParams params(std::uint32_t seed) {

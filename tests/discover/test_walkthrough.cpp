@@ -70,6 +70,9 @@ TEST(Walkthrough, FromNothingToJointAnglesOnSimulatedCameras) {
                        120);
   ASSERT_EQ(cal.exit_code, 0) << cal.output;
   EXPECT_NE(cal.output.find("ground frame set"), std::string::npos) << cal.output;
+  // The report says how the wand balls' centres were found (the rod-side cut).
+  EXPECT_NE(test::read_file(f("rig_report/report.yaml")).find("wand_centres: {rod_cut_deg: "),
+            std::string::npos);
 
   // 2. The robot moving, at the cameras' rate, with the calibrated rig; then discover.
   rec = run_mocap("record --config " +

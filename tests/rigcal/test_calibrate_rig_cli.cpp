@@ -89,6 +89,10 @@ TEST(CalibrateRigCli, Errors) {
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.output.find("--intrinsics-mode: must be auto, refine or fixed"), std::string::npos);
   r = test::run_mocap("calibrate-rig " + dir.file("w") + " --wand " + dir.file("w/wand.yaml") +
+                      " --out " + dir.file("rig.yaml") + " --rod-cut 75");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("--rod-cut: must be 20 to 60 degrees"), std::string::npos) << r.output;
+  r = test::run_mocap("calibrate-rig " + dir.file("w") + " --wand " + dir.file("w/wand.yaml") +
                       " --out " + dir.file("rig.yaml"));
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.output.find(dir.file("w") + ": frames: too few frames"), std::string::npos)

@@ -69,7 +69,17 @@ TEST(Report, YamlAndCoverageFiles) {
   r.quality[0].wand_points_px = {Vec2(1, 1), Vec2(63, 47)};
   r.warnings = {"a \"quoted\" warning"};
   RigCalOptions opt;
+  EXPECT_EQ(format_report_yaml(r, opt).find("wand_centres"), std::string::npos);
+  r.wand_centres.end_ball_views = 120;
+  r.wand_centres.cut_deg = 40.0;
+  r.wand_centres.mean_shift_px[0] = 0.0031;
   const std::string y = format_report_yaml(r, opt);
+  EXPECT_NE(y.find("wand_centres: {rod_cut_deg: 40, chosen_from_recording: false, "
+                   "end_ball_views: 120, outer_rim_used: 0.000,\n"),
+            std::string::npos)
+      << y;
+  EXPECT_NE(y.find("               mean_shift_px: [0.00310, 0.00000, "), std::string::npos);
+  EXPECT_NE(y.find("               cuts_deg: [20, 25, 30, "), std::string::npos);
   EXPECT_NE(y.find("frames_total: 10"), std::string::npos);
   EXPECT_NE(y.find("camera_count: 2\n"), std::string::npos);
   EXPECT_NE(y.find("    t_cam_cam0_mm: [0.0000, 0.0000, 0.0000]\n"), std::string::npos) << y;

@@ -1,0 +1,107 @@
+// Design: the wand balls' image centres over a whole recording, unbiased along the wand.
+//
+// A wand's rod enters its balls. Where it comes towards the camera it hides a notch of
+// the ball's rim, and its blurred flank darkens the rim beside the notch by less than the
+// edge fit can reject. Whatever remains moves each end ball's centre away from the rod:
+// the wand is measured too long in every frame, which sets the rig's scale (and every
+// camera's distance from camera 0) wrong, and no number of frames averages it out
+// (docs/rig_calibration.md, "Partly hidden wand balls"). Leaving out the rim within a
+// cut angle of the axis on the rod's side removes the bias but costs precision along the
+// wand, the very direction that sets the scale: the wider the cut, the noisier.
+//
+// How wide the cut must be depends on the rod (its diameter over the ball's), on how the
+// rod is mounted, on the blur and on the balls' sizes in the images: none of it is in
+// the wand file. The default, kDefaultRodCutDeg, leaves out the rim a rod up to ~0.5 x
+// the ball's diameter hides in a sharp image (asin 0.5 = 30 degrees, plus the blur's
+// reach on balls 3 px or more in radius); measured on rendered recordings (a 5 mm rod,
+// 12 mm balls), the bias it leaves is 0.0006 px, below the precision of the mean over
+// a 500-frame recording's views. The recording says whether its rod needs more: every
+// end ball's edge is sampled once (detect::sample_edge) and fitted with each candidate
+// cut (kRodCutsDeg); the widest is the reference. Per candidate, over all end-ball views:
+//  - the mean shift of the centre from the reference, away from the rod: the bias the
+//    narrower cut lets in (positive: the rod pushes the centre out), with its standard
+//    error from the spread over the views;
+//  - the centre's noise along the wand (the fits' own covariance, RMS over the views).
+// When the default's shift exceeds kWidenSigmas standard errors (a thicker rod, a
+// blurrier lens), the cut widens to the narrowest candidate whose shift lies within
+// kKeepSigmas of its standard error. The cut never narrows below the default: a bias
+// smaller than the default's is too small for one recording to measure.
+//
+// The outer side of an end ball (beyond the wand's ends: free, or a handle) is used when
+// its own fit agrees (detect::AxisSide::kChecked). Every centre is finally moved from
+// the silhouette's centre to the projection of the ball's centre (ball_centre_pixel):
+// the perspective and lens offset is outwards in every frame, a few thousandths of a
+// pixel that would otherwise also stretch the wand.
+// Setup-time, offline code: allocates.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <vector>
+
+#include "camera/camera_model.h"
+#include "core/image.h"
+#include "detect/blob.h"
+#include "detect/edge_centre.h"
+#include "rigcal/bundle.h"
+
+namespace mocap::rigcal {
+
+inline constexpr std::array<double, 9> kRodCutsDeg = {20.0, 25.0, 30.0, 35.0, 40.0,
+                                                      45.0, 50.0, 55.0, 60.0};
+inline constexpr double kDefaultRodCutDeg = 35.0;
+inline constexpr double kWidenSigmas = 3.0;
+inline constexpr double kKeepSigmas = 2.0;
+
+// Where a ball sits on the wand, which says on which side of it the rod runs.
+enum class WandBallRole : unsigned char { kFirst, kMiddle, kLast };
+
+// The choice of the rod-side cut and the figures behind it (report.yaml, wand_centres).
+struct RodCutChoice {
+  double cut_deg = kDefaultRodCutDeg;
+  bool from_recording = false;  // chosen from the recording (else fixed by the options)
+  int end_ball_views = 0;       // end-ball views with every candidate fitted
+  double outer_rim_used = 0.0;  // fraction of end-ball views whose outer rim agreed
+  // Per candidate (kRodCutsDeg): the mean shift away from the rod against the widest
+  // cut, its standard error, and the centres' noise along the wand (px).
+  std::array<double, kRodCutsDeg.size()> mean_shift_px{};
+  std::array<double, kRodCutsDeg.size()> standard_error_px{};
+  std::array<double, kRodCutsDeg.size()> along_sd_px{};
+};
+
+// The index of the cut the figures call for (the rule above); exposed for tests.
+std::size_t choose_rod_cut(const RodCutChoice& figures);
+
+// Collects the candidate centres of every wand ball of a recording, then writes the
+// chosen ones into the recording's blobs.
+class WandCentres {
+ public:
+  // One ball of a labelled wand in one image. blobs[frame][camera][slot] receives its
+  // centre in apply(). axis: image direction from the wand's first ball to its last.
+  // Returns false (nothing added) when the ball's edge could not be fitted: the slot
+  // keeps what the caller put there.
+  bool add(const detect::EdgeSamples& samples, const CameraModel& cam, WandBallRole role,
+           const Vec2& axis, std::size_t frame, std::size_t camera, std::size_t slot);
+
+  // The choice over the views added; fixed_cut_deg > 0 forces that cut (the nearest
+  // candidate).
+  RodCutChoice choose(double fixed_cut_deg) const;
+
+  // Writes every added ball's centre for the chosen cut.
+  void apply(const RodCutChoice& choice, FrameBlobs& blobs) const;
+
+ private:
+  struct View {
+    std::size_t frame = 0, camera = 0, slot = 0;
+    bool end = false;
+    bool outer_used = false;  // with the widest cut
+    Vec2 away_from_rod = Vec2::Zero();
+    std::array<double, kRodCutsDeg.size()> var_along_px2{};
+    std::array<Vec2, kRodCutsDeg.size()> centre_px{};
+    std::array<bool, kRodCutsDeg.size()> ok{};
+  };
+  std::vector<View> views_;
+  detect::EdgeCentreConfig cfg_{};
+};
+
+}  // namespace mocap::rigcal
