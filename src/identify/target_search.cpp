@@ -20,7 +20,9 @@ TargetSearch::TargetSearch(const IdentifyConfig& config, double same_ball_mm)
       heap_(static_cast<std::size_t>(config.best_pairs)),
       next_(static_cast<std::size_t>(config.best_pairs), -1),
       src_(3, kMaxMarkers),
-      dst_(3, kMaxMarkers) {}
+      dst_(3, kMaxMarkers),
+      union_src_(3, kMaxMarkers),
+      union_dst_(3, kMaxMarkers) {}
 
 void TargetSearch::push_seed(const Seed& s, SearchStats& stats) noexcept {
   const auto cap = static_cast<int>(heap_.size());
@@ -178,13 +180,18 @@ void TargetSearch::record(double score, const RigidFit& fit) noexcept {
 
 // The current node contradicts the best solution when it puts a marker on another point
 // than the best does, or a point on another marker: the two then tell different
-// identities. Solutions that agree wherever both assign (a subset, a superset, or two
-// that complete each other) do not. A marker on a point within a ball's diameter of the
-// best's point for it is the same identity: one ball measured twice (e.g. whole, and
-// partly hidden through another camera pair).
-bool TargetSearch::contradicts_best() const noexcept {
+// identities. A marker on a point within a ball's diameter of the best's point for it is
+// the same identity: one ball measured twice (e.g. whole, and partly hidden through
+// another camera pair). Solutions that agree wherever both assign (a subset, or two that
+// complete each other) tell one identity only when together they are one solution: the
+// node's extra markers on points that no best point excludes (shared blobs), and the
+// union rigidly consistent (every residual under t). Otherwise they contradict too: e.g.
+// a stray where the best puts a hidden marker, and the true point of another marker the
+// best left out, each consistent alone, never both.
+bool TargetSearch::contradicts_best() noexcept {
   const auto& best = best_->point_of_marker;
   const int k = model_->k;
+  bool adds = false;
   for (int s = 0; s < m_; ++s) {
     const int c = slot_marker_[static_cast<std::size_t>(s)];
     const int sp = slot_point_[static_cast<std::size_t>(s)];
@@ -194,8 +201,32 @@ bool TargetSearch::contradicts_best() const noexcept {
     if (bp >= 0 && (frame_->X(bp) - frame_->X(sp)).squaredNorm() >= same_ball_sq_mm2_) return true;
     for (int a = 0; a < k; ++a)  // the point on another marker
       if (a != c && best[static_cast<std::size_t>(a)] == sp) return true;
+    adds = adds || bp < 0;
   }
-  return false;
+  if (!adds) return false;  // a subset of the best (up to the same balls)
+  // The union: the best's correspondences plus the node's extra ones.
+  int u = 0;
+  for (int a = 0; a < k; ++a) {
+    const int bp = best[static_cast<std::size_t>(a)];
+    if (bp < 0) continue;
+    union_src_.col(u) = model_->M_body[static_cast<std::size_t>(a)];
+    union_dst_.col(u) = frame_->X(bp);
+    ++u;
+  }
+  for (int s = 0; s < m_; ++s) {
+    const int c = slot_marker_[static_cast<std::size_t>(s)];
+    const int sp = slot_point_[static_cast<std::size_t>(s)];
+    if (best[static_cast<std::size_t>(c)] >= 0) continue;
+    for (int a = 0; a < k; ++a) {
+      const int bp = best[static_cast<std::size_t>(a)];
+      if (bp >= 0 && frame_->exclusive(bp, sp)) return true;
+    }
+    union_src_.col(u) = model_->M_body[static_cast<std::size_t>(c)];
+    union_dst_.col(u) = frame_->X(sp);
+    ++u;
+  }
+  const RigidFit fit = fit_rigid(union_src_, union_dst_, u);
+  return !(fit.max_sq_mm2 < config_.t_mm * config_.t_mm);
 }
 
 void TargetSearch::run_pass() noexcept {

@@ -12,7 +12,9 @@
 //  3. Runner-up pass (if ambiguity_ratio > 1): the same search again, now keeping the
 //     best solution that contradicts the winner (a point on another marker or a marker
 //     on another point, unless that point is within a ball's diameter of the winner's:
-//     the same ball measured twice), pruned at ambiguity_ratio * best score. The caller rejects a
+//     the same ball measured twice; or extra markers that cannot join the winner's: on
+//     points a winner's point excludes, or with the union not rigidly consistent),
+//     pruned at ambiguity_ratio * best score. The caller rejects a
 //     winner whose rival is that close: an ambiguous frame gives no identity at all.
 //  4. Pruning that never loses the optimum of the explored seeds: a branch stops when a
 //     lower bound of any completion's score (|r| cannot shrink when points are added to a
@@ -74,7 +76,7 @@ class TargetSearch {
   void extend(int level, double sum_sq) noexcept;
   void run_pass() noexcept;
   void record(double score, const RigidFit& fit) noexcept;
-  bool contradicts_best() const noexcept;
+  bool contradicts_best() noexcept;
   double score_of(int m, double sum_sq) const noexcept;
   double lower_bound(int m_now, int m_max, double sum_sq) const noexcept;
   bool was_seed(int c, int p, int a, int q) const noexcept;
@@ -97,6 +99,8 @@ class TargetSearch {
   int order_count_ = 0;
   FitPoints src_;
   FitPoints dst_;
+  FitPoints union_src_;  // contradicts_best(): the best solution plus the node's extras
+  FitPoints union_dst_;
   int nodes_ = 0;
   bool limit_hit_ = false;
   SearchResult* best_ = nullptr;

@@ -6,6 +6,7 @@
 #include <random>
 
 #include "identify/exhaustive_search.h"
+#include "identify/rigid_fit.h"
 #include "identify/target_search.h"
 #include "tests/identify/identify_test_util.h"
 
@@ -94,17 +95,19 @@ TEST(TargetSearch, AgreesWithExhaustiveSearch) {
 // Two points sharing a blob in one camera: a solution uses at most one of them.
 // The rival (runner-up pass) always contradicts the winner: a marker on another point
 // (farther than a ball's diameter: nearer, it is the same ball measured twice), or a
-// point on another marker. Solutions that agree wherever both assign, such as two
-// 4-marker solutions of a 5-marker target that complete each other, tell the same
-// identities and are never each other's rival (before: any two solutions of which neither
-// was a subset of the other were rivals, and the body was dropped as ambiguous).
+// point on another marker, or extra markers that cannot join the winner's (the union not
+// rigidly consistent). Solutions that agree wherever both assign and together are one
+// solution, such as two 4-marker solutions of a 5-marker target that complete each
+// other, tell the same identities and are never each other's rival (before: any two
+// solutions of which neither was a subset of the other were rivals, and the body was
+// dropped as ambiguous).
 TEST(TargetSearch, RivalAlwaysContradictsTheWinner) {
   std::mt19937_64 rng(23);
   IdentifyConfig cfg;
   const double diameter_mm = 12.0;
   FramePoints frame(cfg.max_points);
   TargetSearch search(cfg, diameter_mm);
-  int rivals = 0;
+  int rivals = 0, complements = 0;
   for (int trial = 0; trial < 300; ++trial) {
     TargetSet set;
     set.bodies.push_back(random_target(rng, 5, "a"));
@@ -115,7 +118,7 @@ TEST(TargetSearch, RivalAlwaysContradictsTheWinner) {
     SearchStats st;
     if (!search.run(model, frame, r, st) || !std::isfinite(r.rival_score)) continue;
     ++rivals;
-    bool contradicts = false;
+    bool contradicts = false, adds = false;
     for (int c = 0; c < model.k; ++c) {
       const int bp = r.point_of_marker[static_cast<std::size_t>(c)];
       const int rp = r.rival_point_of_marker[static_cast<std::size_t>(c)];
@@ -124,10 +127,27 @@ TEST(TargetSearch, RivalAlwaysContradictsTheWinner) {
       for (int a = 0; a < model.k; ++a)
         contradicts =
             contradicts || (a != c && r.point_of_marker[static_cast<std::size_t>(a)] == rp);
+      adds = adds || bp < 0;
+    }
+    if (!contradicts && adds) {
+      // Complementary: a rival only if the two cannot be one solution.
+      ++complements;
+      FitPoints src(3, kMaxMarkers), dst(3, kMaxMarkers);
+      int u = 0;
+      for (int c = 0; c < model.k; ++c) {
+        int p = r.point_of_marker[static_cast<std::size_t>(c)];
+        if (p < 0) p = r.rival_point_of_marker[static_cast<std::size_t>(c)];
+        if (p < 0) continue;
+        src.col(u) = model.M_body[static_cast<std::size_t>(c)];
+        dst.col(u) = frame.X(p);
+        ++u;
+      }
+      contradicts = fit_rigid(src, dst, u).max_sq_mm2 >= cfg.t_mm * cfg.t_mm;
     }
     EXPECT_TRUE(contradicts) << "trial " << trial;
   }
   EXPECT_GT(rivals, 10);  // the property was exercised
+  std::printf("rivals %d, complementary %d\n", rivals, complements);
 }
 
 TEST(TargetSearch, MutuallyExclusiveCandidatesNotBothUsed) {
