@@ -134,10 +134,12 @@ Expected<DetectedRecording> detect_recording(const std::string& dir, const RigCa
         const Vec2 radial = centres.back() - Vec2(cam.cx, cam.cy);
         if (!detect::sample_edge(img[c].view(), b, list.levels().noise_dn, radial.x(), radial.y(),
                                  expected_radial_stretch(cam, centres.back()), edge_cfg, samples))
-          continue;  // the centroid
-        if (role[i] >= 0 && wand_centres.add(samples, cam, static_cast<WandBallRole>(role[i]), axis,
-                                             f, c, centres.size() - 1))
-          continue;  // WandCentres::apply() writes it
+          continue;          // the centroid
+        if (role[i] >= 0) {  // WandCentres::apply() writes it (else: the centroid)
+          wand_centres.add(samples, cam, static_cast<WandBallRole>(role[i]), axis, f, c,
+                           centres.size() - 1);
+          continue;
+        }
         const detect::EdgeCentre e = detect::fit_edge_centre(samples, edge_cfg);
         if (!e.ok) continue;
         Vec2 ball;

@@ -61,7 +61,7 @@ bool WandCentres::add(const detect::EdgeSamples& samples, const CameraModel& cam
     v.ok[j] = true;
     const Eigen::Matrix2d cov{{e.cov_xx_px2, e.cov_xy_px2}, {e.cov_xy_px2, e.cov_yy_px2}};
     v.var_along_px2[j] = u.dot(cov * u);
-    if (j == kReference) v.outer_used = e.checked_used;
+    v.outer_used[j] = e.checked_used;
     any = true;
   }
   if (!any) return false;
@@ -72,20 +72,25 @@ bool WandCentres::add(const detect::EdgeSamples& samples, const CameraModel& cam
 RodCutChoice WandCentres::choose(double fixed_cut_deg) const {
   RodCutChoice out;
   std::array<double, kCuts> sum{}, sum_sq{}, sum_var{};
-  int outer = 0;
+  std::array<int, kCuts> outer{};
   for (const View& v : views_) {
     if (!v.end || std::find(v.ok.begin(), v.ok.end(), false) != v.ok.end()) continue;
     ++out.end_ball_views;
-    outer += v.outer_used ? 1 : 0;
     for (std::size_t j = 0; j < kCuts; ++j) {
       const double s = (v.centre_px[j] - v.centre_px[kReference]).dot(v.away_from_rod);
       sum[j] += s;
       sum_sq[j] += s * s;
       sum_var[j] += v.var_along_px2[j];
+      outer[j] += v.outer_used[j] ? 1 : 0;
     }
   }
   const double n = out.end_ball_views;
-  if (n > 0) out.outer_rim_used = outer / n;
+  // The outer rim's share at the cut finally chosen.
+  auto finish = [&](std::size_t j) {
+    out.cut_deg = kRodCutsDeg[j];
+    if (n > 0) out.outer_rim_used = outer[j] / n;
+    return out;
+  };
   for (std::size_t j = 0; n > 1 && j < kCuts; ++j) {
     out.mean_shift_px[j] = sum[j] / n;
     const double var = std::max(sum_sq[j] / n - out.mean_shift_px[j] * out.mean_shift_px[j], 0.0);
@@ -97,13 +102,11 @@ RodCutChoice WandCentres::choose(double fixed_cut_deg) const {
     for (std::size_t j = 1; j < kCuts; ++j)
       if (std::fabs(kRodCutsDeg[j] - fixed_cut_deg) < std::fabs(kRodCutsDeg[best] - fixed_cut_deg))
         best = j;
-    out.cut_deg = kRodCutsDeg[best];
-    return out;
+    return finish(best);
   }
-  if (out.end_ball_views < kMinViewsToChoose) return out;  // the default cut
-  out.cut_deg = kRodCutsDeg[choose_rod_cut(out)];
+  if (out.end_ball_views < kMinViewsToChoose) return finish(kDefault);
   out.from_recording = true;
-  return out;
+  return finish(choose_rod_cut(out));
 }
 
 void WandCentres::apply(const RodCutChoice& choice, FrameBlobs& blobs) const {

@@ -61,7 +61,7 @@ struct RodCutChoice {
   double cut_deg = kDefaultRodCutDeg;
   bool from_recording = false;  // chosen from the recording (else fixed by the options)
   int end_ball_views = 0;       // end-ball views with every candidate fitted
-  double outer_rim_used = 0.0;  // fraction of end-ball views whose outer rim agreed
+  double outer_rim_used = 0.0;  // fraction of end-ball views whose outer rim agreed (at cut_deg)
   // Per candidate (kRodCutsDeg): the mean shift away from the rod against the widest
   // cut, its standard error, and the centres' noise along the wand (px).
   std::array<double, kRodCutsDeg.size()> mean_shift_px{};
@@ -94,7 +94,7 @@ class WandCentres {
   struct View {
     std::size_t frame = 0, camera = 0, slot = 0;
     bool end = false;
-    bool outer_used = false;  // with the widest cut
+    std::array<bool, kRodCutsDeg.size()> outer_used{};  // the outer rim agreed
     Vec2 away_from_rod = Vec2::Zero();
     std::array<double, kRodCutsDeg.size()> var_along_px2{};
     std::array<Vec2, kRodCutsDeg.size()> centre_px{};
