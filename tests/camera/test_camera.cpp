@@ -260,8 +260,8 @@ Silhouette ball_silhouette(const CameraModel& c, const Vec3& X, double R) {
   const double rho = R * std::sqrt(D * D - R * R) / D;  // the tangency circle
   const Vec3 ring = X - w * (R * R / D);
   std::vector<Vec2> contour;
-  for (int k = 0; k < 4000; ++k) {
-    const double phi = 2.0 * M_PI * k / 4000.0;
+  for (int k = 0; k < 1440; ++k) {
+    const double phi = 2.0 * M_PI * k / 1440.0;
     Vec2 px;
     EXPECT_TRUE(project(c, ring + rho * (std::cos(phi) * a + std::sin(phi) * b), px));
     contour.push_back(px);
