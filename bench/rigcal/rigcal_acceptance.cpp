@@ -18,9 +18,11 @@
 // axis (the wand balls' centres: intensity centroid, edge fit, edge fit without the rim
 // along the wand's axis on the rod's side; default axis, as mocap calibrate-rig),
 // RIGCAL_ROD_CUT = degrees (that cut instead of the one chosen from the recording),
-// RIGCAL_TRUTH_NOISE = sigma px (the wand centres replaced by their true projections
-// plus Gaussian noise: the noise floor of the geometry and frame count).
-// Each run renders into its own folder under $TMPDIR (rigcal_acceptance_<seed>_<cameras>).
+// RIGCAL_SIM_BLUR = px, RIGCAL_SIM_NOISE = DN (the renderer's PSF sigma and read noise
+// instead of the defaults: other lenses and sensors), RIGCAL_TRUTH_NOISE = sigma px (the wand
+// centres replaced by their true projections plus Gaussian noise: the noise floor of the geometry
+// and frame count). Each run renders into its own folder under $TMPDIR
+// (rigcal_acceptance_<seed>_<cameras>).
 #include <Eigen/Geometry>
 #include <chrono>
 #include <cmath>
@@ -82,6 +84,8 @@ int main(int argc, char** argv) {
   so.seed = seed;
   so.stray = 3;
   so.dropout = 0.02;
+  if (const char* b = std::getenv("RIGCAL_SIM_BLUR")) so.blur_px = std::atof(b);
+  if (const char* n = std::getenv("RIGCAL_SIM_NOISE")) so.noise_dn = std::atof(n);
   so.cameras = cameras;
   auto t0 = std::chrono::steady_clock::now();
   auto w = sim::write_calibration_recording(so, sim::CalibObjectKind::kWand, dir + "/wand");
