@@ -34,13 +34,15 @@ TargetSet unambiguous_set(std::mt19937_64& rng, int bodies, const IdentifyConfig
 }
 
 // Acceptance: 0 wrong identities over 10,000 random frames (3 bodies of 4-6 markers, 10
-// stray points, random occlusion down to 3 markers, 0.1-0.3 mm noise).
+// stray points, random occlusion down to 3 markers, 0.1-0.3 mm noise). The full count in
+// every build (~30 s under the sanitizers): CI runs only the sanitizer build, and a tenth
+// of the trials once missed the 3 frames that gave wrong identities.
 TEST(Identifier, NoWrongIdentityInRandomTrials) {
   std::mt19937_64 rng(2026);
   IdentifyConfig cfg;
   cfg.temporal = false;
   cfg.point_sigma_mm = 0.3;  // the consistency test set to the largest noise of the trials
-  const int trials = test::scaled_trials(10000);
+  const int trials = 10000;
   int wrong = 0, missed = 0, bodies = 0;
   std::uint64_t ambiguous = 0;
   TargetSet set;
