@@ -131,11 +131,12 @@ int main(int argc, char** argv) {
         }
       }
     }
-    std::printf(
-        "wand centres: %d frames, seed %llu, %d cameras, centres %s, rod-side cut %.0f deg "
-        "(%s)\n",
-        frames, static_cast<unsigned long long>(seed), cameras, centres.c_str(),
-        detected->rod_cut.cut_deg, detected->rod_cut.from_recording ? "chosen" : "fixed");
+    std::printf("wand centres: %d frames, seed %llu, %d cameras, centres %s", frames,
+                static_cast<unsigned long long>(seed), cameras, centres.c_str());
+    if (detected->rod_cut.end_ball_views > 0)  // only the axis method has a rod-side cut
+      std::printf(", rod-side cut %.0f deg (%s)", detected->rod_cut.cut_deg,
+                  detected->rod_cut.from_recording ? "chosen" : "fixed");
+    std::printf("\n");
     for (std::size_t m = 0; m < M; ++m)
       std::printf(
           "  marker %zu (%5.0f mm): %6.0f views  along mean %+.4f sd %.4f px   across "

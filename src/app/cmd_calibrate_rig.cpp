@@ -222,8 +222,8 @@ void register_calibrate_rig(CLI::App& app, int& exit_code) {
   cmd->add_option("--min-frames", args->min_frames,
                   "Fewest frames with the wand in two or more cameras (default 30)");
   cmd->add_option("--rod-cut", args->rod_cut_deg,
-                  "Degrees of each wand ball's rim left out beside the rod (20..60); default: "
-                  "chosen from the recording");
+                  "Degrees of each wand ball's rim left out beside the rod (20..60, taken to "
+                  "the nearest 5); default: chosen from the recording");
   cmd->callback([args, &exit_code] { exit_code = run(*args); });
 }
 

@@ -75,13 +75,13 @@ Expected<DetectedRecording> detect_recording(const std::string& dir, const RigCa
   detect::BlobList list = det[0].make_blob_list();
   DetectedRecording out;
   out.blobs.assign(rec->frames().size(), std::vector<std::vector<Vec2>>(C));
-  WandCentres wand_centres;
   std::vector<const detect::Blob*> kept;
   std::vector<int> role;  // per kept blob: -1 not on the wand, else its WandBallRole
   std::vector<Vec2> scaled;
   std::vector<std::size_t> index;
   std::vector<int> order;
   const detect::EdgeCentreConfig edge_cfg{};
+  WandCentres wand_centres(edge_cfg);
   detect::EdgeSamples samples;
   for (std::size_t f = 0; f < rec->frames().size(); ++f) {
     for (std::size_t c = 0; c < C; ++c) {

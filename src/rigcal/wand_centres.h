@@ -11,11 +11,11 @@
 //
 // How wide the cut must be depends on the rod (its diameter over the ball's), on how the
 // rod is mounted, on the blur and on the balls' sizes in the images: none of it is in
-// the wand file. The default, kDefaultRodCutDeg, leaves out the rim a rod up to ~0.5 x
-// the ball's diameter hides in a sharp image (asin 0.5 = 30 degrees, plus the blur's
-// reach on balls 3 px or more in radius); measured on rendered recordings (a 5 mm rod,
-// 12 mm balls), the bias it leaves is 0.0006 px, below the precision of the mean over
-// a 500-frame recording's views. The recording says whether its rod needs more: every
+// the wand file. The default, kDefaultRodCutDeg, is a prior: a rod half the ball's
+// diameter hides the rim within asin(0.5) = 30 degrees in a sharp image, and its blurred
+// flank reaches about one edge width further (PSF and pixel, ~0.6 px: 5.7 degrees of
+// rim on a ball 6 px in radius, 11 on one of 3 px). Smaller or blurrier balls, or a
+// thicker rod, need more, and the recording says so: every
 // end ball's edge is sampled once (detect::sample_edge) and fitted with each candidate
 // cut (kRodCutsDeg); the widest is the reference. Per candidate, over all end-ball views:
 //  - the mean shift of the centre from the reference, away from the rod: the bias the
@@ -40,8 +40,6 @@
 #include <vector>
 
 #include "camera/camera_model.h"
-#include "core/image.h"
-#include "detect/blob.h"
 #include "detect/edge_centre.h"
 #include "rigcal/bundle.h"
 
@@ -76,6 +74,9 @@ std::size_t choose_rod_cut(const RodCutChoice& figures);
 // chosen ones into the recording's blobs.
 class WandCentres {
  public:
+  // cfg: the edge fit's configuration, the one the samples were taken with.
+  explicit WandCentres(const detect::EdgeCentreConfig& cfg = {}) : cfg_(cfg) {}
+
   // One ball of a labelled wand in one image. blobs[frame][camera][slot] receives its
   // centre in apply(). axis: image direction from the wand's first ball to its last.
   // Returns false (nothing added) when the ball's edge could not be fitted: the slot
