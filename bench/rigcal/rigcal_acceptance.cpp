@@ -11,7 +11,8 @@
 //  - ground frame: camera centres and rotations of the L-frame rig vs the truth.
 //  - every camera's pose relative to camera 0 (position of its centre in camera 0's
 //    frame, mm, and rotation, deg) against the truth: with 3..8 cameras (the simulator's
-//    built-in ring) the acceptance figure of the N-camera calibration.
+//    built-in ring) the acceptance figure of the N-camera calibration;
+//  - per camera, the frames that labelled the wand, those used, and why the others did not.
 // Usage: rigcal_acceptance [frames] [seed] [intrinsics: true|perturbed] [mode: auto|refine|fixed]
 //                          [cameras: 2..8]
 // Environment: RIGCAL_MIN_ROUNDNESS (the blob filter), RIGCAL_CENTRES = centroid | edge |
@@ -21,8 +22,8 @@
 // RIGCAL_SIM_BLUR = px, RIGCAL_SIM_NOISE = DN (the renderer's PSF sigma and read noise
 // instead of the defaults: other lenses and sensors), RIGCAL_TRUTH_NOISE = sigma px (the wand
 // centres replaced by their true projections plus Gaussian noise: the noise floor of the geometry
-// and frame count). Each run renders into its own folder under $TMPDIR
-// (rigcal_acceptance_<seed>_<cameras>).
+// and frame count), RIGCAL_WEIGHTS=0 (every centre weighs the same in the bundle adjustment). Each
+// run renders into its own folder under $TMPDIR (rigcal_acceptance_<seed>_<cameras>).
 #include <Eigen/Geometry>
 #include <chrono>
 #include <cmath>
@@ -146,7 +147,11 @@ int main(int argc, char** argv) {
     }
   }
   auto t2 = std::chrono::steady_clock::now();
-  auto res = rigcal::calibrate_from_blobs(*blobs, wand, intr, opt, dir + "/wand");
+  // RIGCAL_WEIGHTS=0: every centre weighs the same (the truth-noise centres always do).
+  if (const char* wt = std::getenv("RIGCAL_WEIGHTS")) opt.weight_centres = std::atoi(wt) != 0;
+  auto res =
+      rigcal::calibrate_from_blobs(*blobs, wand, intr, opt, dir + "/wand",
+                                   std::getenv("RIGCAL_TRUTH_NOISE") ? nullptr : &detected->info);
   if (!res) {
     std::fprintf(stderr, "%s\n", res.error().message.c_str());
     return 1;
@@ -251,14 +256,14 @@ int main(int argc, char** argv) {
   std::printf("frames %d seed %llu intrinsics %s mode %s cameras %d centres %s\n", frames,
               static_cast<unsigned long long>(seed), intr_mode.c_str(), mode.c_str(), cameras,
               centres.c_str());
-  {
-    const rigcal::RodCutChoice& rc = detected->rod_cut;
+  for (const rigcal::RodCutChoice* cut : {&detected->rod_cut, &detected->rod_cut_partly_hidden}) {
+    const rigcal::RodCutChoice& rc = *cut;
     std::printf(
-        "  wand centres: rod-side cut %.0f deg (%s), %d end-ball views, outer rim used in "
+        "  wand centres%s: rod-side cut %.0f deg (%s), %d end-ball views, outer rim used in "
         "%.0f %%; per cut: mean shift away from the rod (its standard error) / along-wand noise, "
         "px:",
-        rc.cut_deg, rc.from_recording ? "chosen" : "fixed", rc.end_ball_views,
-        100.0 * rc.outer_rim_used);
+        cut == &detected->rod_cut ? "" : " (partly hidden)", rc.cut_deg,
+        rc.from_recording ? "chosen" : "fixed", rc.end_ball_views, 100.0 * rc.outer_rim_used);
     for (std::size_t j = 0; j < rigcal::kRodCutsDeg.size(); ++j)
       std::printf(" %.0f:%+.4f(%.4f)/%.3f", rigcal::kRodCutsDeg[j], rc.mean_shift_px[j],
                   rc.standard_error_px[j], rc.along_sd_px[j]);
@@ -300,6 +305,14 @@ int main(int argc, char** argv) {
         "baseline %.0f mm), rotation error %.5f deg, reprojection RMS %.4f px\n",
         cal[c].name.c_str(), cal[0].name.c_str(), pos_mm, along_mm, C_true.norm(), deg,
         res->quality[c].reprojection_rms_px);
+  }
+  for (std::size_t c = 0; c < cal.size(); ++c) {
+    const auto& q = res->quality[c];
+    std::printf(
+        "  %s: labelled %d, used %d; rejected: too few blobs %d, too many %d, no wand %d, "
+        "ambiguous %d\n",
+        cal[c].name.c_str(), q.frames_labelled, q.frames_used, q.label_status[1], q.label_status[2],
+        q.label_status[3], q.label_status[4]);
   }
   std::printf("  worst camera pose error %.4f mm, %.5f deg\n", worst_mm, worst_deg);
   std::printf(

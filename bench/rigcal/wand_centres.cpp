@@ -5,7 +5,8 @@
 // wand marker the mean (bias) and standard deviation of the centre's error along the
 // wand's image axis (from marker 0 towards the last marker) and across it.
 // The end balls' bias is also given combined, signed away from the rod (outwards), the
-// figure that stretches the wand. With `axis`, RIGCAL_ROD_CUT=a,b,c runs each fixed cut
+// figure that stretches the wand. Whole balls and partly hidden ones (less round, kept
+// as wand balls) are counted apart. With `axis`, RIGCAL_ROD_CUT=a,b,c runs each fixed cut
 // in turn (default: the cut chosen from the recording).
 // Usage: wand_centres [frames] [seed] [cameras] [centroid|edge|axis]
 #include <cmath>
@@ -93,8 +94,10 @@ int main(int argc, char** argv) {
     }
     const rigcal::FrameBlobs* blobs = &detected->blobs;
     const std::size_t M = wand.markers_mm.size();
-    std::vector<Acc> along(M), across(M);
-    Acc outward;
+    // Per class: [0] whole balls, [1] partly hidden ones (less round, kept as wand balls).
+    std::vector<Acc> along[2] = {std::vector<Acc>(M), std::vector<Acc>(M)};
+    std::vector<Acc> across[2] = {std::vector<Acc>(M), std::vector<Acc>(M)};
+    Acc outward[2];
     std::vector<int> order;
     std::vector<Vec2> scaled;
     for (std::size_t fi = 0; fi < blobs->size(); ++fi) {
@@ -121,13 +124,15 @@ int main(int argc, char** argv) {
         for (std::size_t m = 0; m < M; ++m) {
           const auto g = gt.find({static_cast<int>(fi), static_cast<int>(m)});
           if (g == gt.end()) continue;
-          const Vec2 e =
-              pts[idx[static_cast<std::size_t>(order[m])]] - g->second[static_cast<std::size_t>(c)];
+          const std::size_t slot = idx[static_cast<std::size_t>(order[m])];
+          const Vec2 e = pts[slot] - g->second[static_cast<std::size_t>(c)];
           if (e.norm() > 1.0) continue;
-          along[m].add(e.dot(u));
-          across[m].add(e.dot(n));
-          if (m == 0) outward.add(-e.dot(u));
-          if (m + 1 == M) outward.add(e.dot(u));
+          const auto& info = detected->info[fi][static_cast<std::size_t>(c)];
+          const int k = slot < info.size() && info[slot].partly_hidden ? 1 : 0;
+          along[k][m].add(e.dot(u));
+          across[k][m].add(e.dot(n));
+          if (m == 0) outward[k].add(-e.dot(u));
+          if (m + 1 == M) outward[k].add(e.dot(u));
         }
       }
     }
@@ -137,15 +142,18 @@ int main(int argc, char** argv) {
       std::printf(", rod-side cut %.0f deg (%s)", detected->rod_cut.cut_deg,
                   detected->rod_cut.from_recording ? "chosen" : "fixed");
     std::printf("\n");
-    for (std::size_t m = 0; m < M; ++m)
-      std::printf(
-          "  marker %zu (%5.0f mm): %6.0f views  along mean %+.4f sd %.4f px   across "
-          "mean %+.4f sd %.4f px\n",
-          m, wand.markers_mm[m], along[m].n, along[m].mean(), along[m].sd(), across[m].mean(),
-          across[m].sd());
-    std::printf("  end balls outwards: mean %+.5f px (standard error %.5f) over %.0f views\n",
-                outward.mean(), outward.sd() / std::sqrt(std::max(outward.n - 1.0, 1.0)),
-                outward.n);
+    for (int k = 0; k < 2; ++k) {
+      std::printf("  %s balls:\n", k == 0 ? "whole" : "partly hidden");
+      for (std::size_t m = 0; m < M; ++m)
+        std::printf(
+            "    marker %zu (%5.0f mm): %6.0f views  along mean %+.4f sd %.4f px   across "
+            "mean %+.4f sd %.4f px\n",
+            m, wand.markers_mm[m], along[k][m].n, along[k][m].mean(), along[k][m].sd(),
+            across[k][m].mean(), across[k][m].sd());
+      std::printf("    end balls outwards: mean %+.5f px (standard error %.5f) over %.0f views\n",
+                  outward[k].mean(), outward[k].sd() / std::sqrt(std::max(outward[k].n - 1.0, 1.0)),
+                  outward[k].n);
+    }
   }
   return 0;
 }

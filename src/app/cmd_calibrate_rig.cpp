@@ -164,10 +164,11 @@ int run(const RigArgs& a) {
   }
   auto detected = rigcal::detect_recording(a.recording, opt, &intr, &objects->wand);
   if (!detected) return fail(detected.error().message);
-  auto result =
-      rigcal::calibrate_from_blobs(detected->blobs, objects->wand, intr, opt, a.recording);
+  auto result = rigcal::calibrate_from_blobs(detected->blobs, objects->wand, intr, opt, a.recording,
+                                             &detected->info);
   if (!result) return fail(result.error().message);
   result->wand_centres = detected->rod_cut;
+  result->wand_centres_partly_hidden = detected->rod_cut_partly_hidden;
   if (!a.lframe.empty()) {
     auto lb = rigcal::detect_recording(a.lframe, opt, &intr);
     if (!lb) return fail(lb.error().message);

@@ -5,6 +5,7 @@
 #include <ceres/product_manifold.h>
 #include <ceres/rotation.h>
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -15,6 +16,7 @@ namespace {
 struct WandReprojection {
   Vec2 obs;
   double offset_mm;
+  Eigen::Matrix2d weight;  // W, W^T W = the centre's relative information (identity: none)
   template <class T>
   bool operator()(const T* intr, const T* pose, const T* wand, T* res) const {
     const T* A = wand;
@@ -31,8 +33,9 @@ struct WandReprojection {
     const T radial = T(1) + intr[4] * r2 + intr[5] * r2 * r2 + intr[8] * r2 * r2 * r2;
     const T xd = x * radial + T(2) * intr[6] * x * y + intr[7] * (r2 + T(2) * x * x);
     const T yd = y * radial + intr[6] * (r2 + T(2) * y * y) + T(2) * intr[7] * x * y;
-    res[0] = intr[0] * xd + intr[2] - obs.x();
-    res[1] = intr[1] * yd + intr[3] - obs.y();
+    const T ex = intr[0] * xd + intr[2] - obs.x(), ey = intr[1] * yd + intr[3] - obs.y();
+    res[0] = weight(0, 0) * ex + weight(0, 1) * ey;
+    res[1] = weight(1, 0) * ex + weight(1, 1) * ey;
     return true;
   }
 };
@@ -71,6 +74,43 @@ void set_pose(CameraModel& c, const std::array<double, 6>& p) {
   c.R_cam_world =
       a > 0.0 ? Mat3(Eigen::AngleAxisd(a, v / a).toRotationMatrix()) : Mat3(Mat3::Identity());
   c.t_cam_world = Vec3(p[3], p[4], p[5]);
+}
+
+// A centre's weight relative to the median centre of the recording's labelled views:
+// W with W^T W = s2 cov^-1, s2 the median of the covariances' mean variance. A centre
+// without a covariance weighs as the median. Variances are floored at s2 / 4 (a
+// centre at most twice as precise as the median): the fit's own covariance rests on
+// the residuals of 32..64 edge points and a lucky fit must not outweigh its rays.
+std::vector<std::vector<std::vector<Eigen::Matrix2d>>> centre_weights(
+    const std::vector<WandFrame>& frames, std::size_t markers, bool enabled) {
+  std::vector<double> v;
+  for (const WandFrame& f : frames)
+    for (const auto& cam : f.info)
+      for (const CentreInfo& c : cam)
+        if (c.cov_px2.trace() > 0.0) v.push_back(0.5 * c.cov_px2.trace());
+  std::vector<std::vector<std::vector<Eigen::Matrix2d>>> out(frames.size());
+  double s2 = 0.0;
+  if (enabled && !v.empty()) {
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+    s2 = v[v.size() / 2];
+  }
+  for (std::size_t f = 0; f < frames.size(); ++f) {
+    out[f].assign(frames[f].px.size(),
+                  std::vector<Eigen::Matrix2d>(markers, Eigen::Matrix2d::Identity()));
+    if (!(s2 > 0.0)) continue;
+    for (std::size_t c = 0; c < frames[f].info.size() && c < frames[f].px.size(); ++c) {
+      for (std::size_t k = 0; k < markers && k < frames[f].info[c].size(); ++k) {
+        const Eigen::Matrix2d& cov = frames[f].info[c][k].cov_px2;
+        if (!(cov.trace() > 0.0)) continue;
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(cov / s2);
+        const Eigen::Vector2d lambda = es.eigenvalues().cwiseMax(0.25);
+        // W = diag(lambda)^-1/2 V^T: W^T W = V diag(lambda)^-1 V^T.
+        out[f][c][k] =
+            lambda.cwiseSqrt().cwiseInverse().asDiagonal() * es.eigenvectors().transpose();
+      }
+    }
+  }
+  return out;
 }
 
 }  // namespace
@@ -118,6 +158,7 @@ Expected<BundleStats> bundle_adjust(const WandSpec& wand, const std::vector<Wand
   BundleStats stats;
   std::vector<double> err;
   std::vector<int> err_cam;
+  const auto weights = centre_weights(frames, wand.markers_mm.size(), options.weight_by_covariance);
   for (int round = 0; round < std::max(1, options.rounds); ++round) {
     std::vector<std::array<double, 9>> intr(C);
     std::vector<std::array<double, 6>> pose(C);
@@ -140,8 +181,9 @@ Expected<BundleStats> bundle_adjust(const WandSpec& wand, const std::vector<Wand
         if (frames[f].px[c].empty()) continue;
         observed[c] = true;
         for (std::size_t k = 0; k < wand.markers_mm.size(); ++k) {
-          auto* cost = new ceres::AutoDiffCostFunction<WandReprojection, 2, 9, 6, 6>(
-              new WandReprojection{frames[f].px[c][k], wand.markers_mm[k] - wand.markers_mm[0]});
+          auto* cost =
+              new ceres::AutoDiffCostFunction<WandReprojection, 2, 9, 6, 6>(new WandReprojection{
+                  frames[f].px[c][k], wand.markers_mm[k] - wand.markers_mm[0], weights[f][c][k]});
           problem.AddResidualBlock(cost, loss, intr[c].data(), pose[c].data(), W[f].data());
         }
       }

@@ -5,7 +5,9 @@
 // and a unit direction d (SphereManifold), so marker k sits exactly at A + s_k d: the
 // wand's length fixes the metric scale and collinearity is built in. Residuals are the
 // reprojection errors in the real (distorted) images through the same model as
-// camera_model.h (OpenCV's 5-parameter distortion), with a Huber loss. Intrinsics
+// camera_model.h (OpenCV's 5-parameter distortion), each weighed by its centre's
+// covariance relative to the recording's median centre (when the frames carry them),
+// with a Huber loss. Intrinsics
 // [fx fy cx cy k1 k2 p1 p2 k3] are constant unless refine_intrinsics; then fx, fy, cx,
 // cy, k1, k2 are estimated and p1, p2, k3 stay as given (weakly observable from a wand);
 // this is decided per camera (refine_camera). A frame takes part when the wand is
@@ -25,12 +27,20 @@ namespace mocap::rigcal {
 // Blob centres (distorted pixels) per frame and camera: blobs[f][c], every frame with
 // one entry per camera of the rig.
 using FrameBlobs = std::vector<std::vector<std::vector<Vec2>>>;
+// What the detection knows of one centre of a FrameBlobs.
+struct CentreInfo {
+  Eigen::Matrix2d cov_px2 = Eigen::Matrix2d::Zero();  // the edge fit's (zero: not known)
+  bool partly_hidden = false;  // less round than a whole ball there: its rim is cut
+};
+// Per centre of a FrameBlobs, the same shape.
+using FrameCentreInfo = std::vector<std::vector<std::vector<CentreInfo>>>;
 
 // One frame of the wand (distorted pixels, marker order). px has one entry per camera;
-// an empty entry: the wand is not labelled in that camera.
+// an empty entry: the wand is not labelled in that camera. info: empty, or as px.
 struct WandFrame {
   int frame = 0;
   std::vector<std::vector<Vec2>> px;
+  std::vector<std::vector<CentreInfo>> info;
   int cameras_labelled() const noexcept;
 };
 
@@ -44,6 +54,10 @@ struct BundleOptions {
   bool refine_intrinsics = false;
   // Per camera; empty: every camera as refine_intrinsics says.
   std::vector<bool> refine_camera;
+  // Each residual weighed by its centre's covariance (WandFrame::info) relative to
+  // the median centre's, so a typical centre's residual stays in pixels; a centre
+  // without one weighs as the median. Off, or no covariances: all weigh the same.
+  bool weight_by_covariance = true;
   double huber_px = 1.0;
   // Frames with a marker residual above clamp(outlier_sigmas x RMS, outlier_min_px,
   // outlier_px) after a round are dropped.

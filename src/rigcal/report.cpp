@@ -43,14 +43,17 @@ std::string format_report_yaml(const RigCalResult& r, const RigCalOptions& opt) 
   s += "wand_length_error_mm: {mean: " + num(r.wand_length_mean_error_mm, 4) +
        ", rms: " + num(r.wand_length_rms_error_mm, 4) +
        ", samples: " + std::to_string(r.wand_length_samples) + "}\n";
-  if (r.wand_centres.end_ball_views > 0) {
-    const RodCutChoice& w = r.wand_centres;
-    s += "wand_centres: {rod_cut_deg: " + num(w.cut_deg, 0) +
+  // wand_centres: the whole end balls; wand_centres_partly_hidden: those whose blob was
+  // less round than a whole ball's (their own cut).
+  auto centres = [&](const std::string& name, const RodCutChoice& w) {
+    if (w.end_ball_views == 0) return;
+    const std::string indent(name.size() + 3, ' ');
+    s += name + ": {rod_cut_deg: " + num(w.cut_deg, 0) +
          ", chosen_from_recording: " + (w.from_recording ? "true" : "false") +
          ", end_ball_views: " + std::to_string(w.end_ball_views) +
          ", outer_rim_used: " + num(w.outer_rim_used, 3) + ",\n";
     auto list = [&](const char* key, const auto& values, int digits, bool last) {
-      s += std::string("               ") + key + ": [";
+      s += indent + key + ": [";
       for (std::size_t j = 0; j < values.size(); ++j) s += (j ? ", " : "") + num(values[j], digits);
       s += last ? "]}\n" : "],\n";
     };
@@ -58,7 +61,9 @@ std::string format_report_yaml(const RigCalResult& r, const RigCalOptions& opt) 
     list("mean_shift_px", w.mean_shift_px, 5, false);
     list("standard_error_px", w.standard_error_px, 5, false);
     list("along_sd_px", w.along_sd_px, 5, true);
-  }
+  };
+  centres("wand_centres", r.wand_centres);
+  centres("wand_centres_partly_hidden", r.wand_centres_partly_hidden);
   s += "cameras:\n";
   for (const CameraQuality& q : r.quality) {
     s += "  - name: " + quoted(q.name) + "\n";

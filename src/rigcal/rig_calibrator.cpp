@@ -75,8 +75,10 @@ Expected<DetectedRecording> detect_recording(const std::string& dir, const RigCa
   detect::BlobList list = det[0].make_blob_list();
   DetectedRecording out;
   out.blobs.assign(rec->frames().size(), std::vector<std::vector<Vec2>>(C));
+  out.info.assign(rec->frames().size(), std::vector<std::vector<CentreInfo>>(C));
   std::vector<const detect::Blob*> kept;
-  std::vector<int> role;  // per kept blob: -1 not on the wand, else its WandBallRole
+  std::vector<bool> round;  // per kept blob: as round as a whole ball there
+  std::vector<int> role;    // per kept blob: -1 not on the wand, else its WandBallRole
   std::vector<Vec2> scaled;
   std::vector<std::size_t> index;
   std::vector<int> order;
@@ -91,30 +93,41 @@ Expected<DetectedRecording> detect_recording(const std::string& dir, const RigCa
       det[c].detect(img[c].view(), list);
       const CameraModel& cam = cams ? (*cams)[c] : rec->rig().cameras[c];
       kept.clear();
+      round.clear();
       for (const detect::Blob& b : list) {
         if (b.has(detect::kBlobTouchesBorder) || b.has(detect::kBlobMerged) ||
             b.has(detect::kBlobSplit))
           continue;
         const Vec2 px(b.x_px, b.y_px);
-        if (opt.min_roundness > 0.0 &&
-            static_cast<double>(b.roundness) < opt.min_roundness * expected_roundness(cam, px))
-          continue;
+        const bool is_round =
+            !(opt.min_roundness > 0.0 &&
+              static_cast<double>(b.roundness) < opt.min_roundness * expected_roundness(cam, px));
+        // A blob less round than a whole ball is kept only as a wand ball whose edge is
+        // fitted (below): its centroid is biased, the fit leaves the hidden rim out.
+        if (!is_round && !(opt.edge_centres && wand)) continue;
         kept.push_back(&b);
+        round.push_back(is_round);
       }
       // The wand in this image, labelled on the centroids: its balls' centres come from
       // WandCentres (the rim along the wand's axis left out on the rod's side).
       Vec2 axis = Vec2::Zero();
       role.assign(kept.size(), -1);
       if (opt.edge_centres && wand) {
-        scaled.clear();
-        index.clear();
-        for (std::size_t i = 0; i < kept.size(); ++i) {
-          Vec2 xn;
-          if (!undistort_pixel(cam, Vec2(kept[i]->x_px, kept[i]->y_px), xn)) continue;
-          scaled.push_back(to_scaled(cam, xn));
-          index.push_back(i);
-        }
-        if (label_wand(*wand, opt.label, scaled, order) == LabelStatus::kOk) {
+        // Labelled on every kept blob, else (a less round stray or a piece of a ball
+        // cut in two on the wand's segment) on the round ones alone.
+        auto label = [&](bool round_only) {
+          scaled.clear();
+          index.clear();
+          for (std::size_t i = 0; i < kept.size(); ++i) {
+            Vec2 xn;
+            if (round_only && !round[i]) continue;
+            if (!undistort_pixel(cam, Vec2(kept[i]->x_px, kept[i]->y_px), xn)) continue;
+            scaled.push_back(to_scaled(cam, xn));
+            index.push_back(i);
+          }
+          return label_wand(*wand, opt.label, scaled, order) == LabelStatus::kOk;
+        };
+        if (label(false) || label(true)) {
           const detect::Blob& a = *kept[index[static_cast<std::size_t>(order.front())]];
           const detect::Blob& z = *kept[index[static_cast<std::size_t>(order.back())]];
           axis = Vec2(z.x_px - a.x_px, z.y_px - a.y_px);
@@ -127,36 +140,48 @@ Expected<DetectedRecording> detect_recording(const std::string& dir, const RigCa
         }
       }
       auto& centres = out.blobs[f][c];
+      auto& info = out.info[f][c];
       for (std::size_t i = 0; i < kept.size(); ++i) {
         const detect::Blob& b = *kept[i];
+        if (!round[i] && role[i] < 0) continue;  // not a wand ball: a stray or a cut piece
         centres.emplace_back(b.x_px, b.y_px);
+        info.push_back(CentreInfo{Eigen::Matrix2d::Zero(), !round[i]});
         if (!opt.edge_centres) continue;
         const Vec2 radial = centres.back() - Vec2(cam.cx, cam.cy);
-        if (!detect::sample_edge(img[c].view(), b, list.levels().noise_dn, radial.x(), radial.y(),
-                                 expected_radial_stretch(cam, centres.back()), edge_cfg, samples))
-          continue;          // the centroid
-        if (role[i] >= 0) {  // WandCentres::apply() writes it (else: the centroid)
-          wand_centres.add(samples, cam, static_cast<WandBallRole>(role[i]), axis, f, c,
-                           centres.size() - 1);
+        const bool sampled =
+            detect::sample_edge(img[c].view(), b, list.levels().noise_dn, radial.x(), radial.y(),
+                                expected_radial_stretch(cam, centres.back()), edge_cfg, samples);
+        if (role[i] >= 0) {  // WandCentres::apply() writes it (else: the centroid, if round)
+          if (!(sampled && wand_centres.add(samples, cam, static_cast<WandBallRole>(role[i]), axis,
+                                            f, c, centres.size() - 1, !round[i])) &&
+              !round[i]) {
+            centres.pop_back();
+            info.pop_back();
+          }
           continue;
         }
+        if (!sampled) continue;  // the centroid
         const detect::EdgeCentre e = detect::fit_edge_centre(samples, edge_cfg);
         if (!e.ok) continue;
         Vec2 ball;
-        if (ball_centre_pixel(cam, Vec2(e.x_px, e.y_px), e.radius_px, ball)) centres.back() = ball;
+        if (!ball_centre_pixel(cam, Vec2(e.x_px, e.y_px), e.radius_px, ball)) continue;
+        centres.back() = ball;
+        info.back().cov_px2 << e.cov_xx_px2, e.cov_xy_px2, e.cov_xy_px2, e.cov_yy_px2;
       }
     }
   }
   if (opt.edge_centres && wand) {
-    out.rod_cut = wand_centres.choose(opt.rod_cut_deg);
-    wand_centres.apply(out.rod_cut, out.blobs);
+    out.rod_cut = wand_centres.choose(opt.rod_cut_deg, false);
+    out.rod_cut_partly_hidden = wand_centres.choose(opt.rod_cut_deg, true);
+    wand_centres.apply(out.rod_cut, out.blobs, &out.info, &out.rod_cut_partly_hidden);
   }
   return out;
 }
 
 Expected<RigCalResult> calibrate_from_blobs(const FrameBlobs& blobs, const WandSpec& wand,
                                             const std::vector<CameraModel>& intrinsics,
-                                            const RigCalOptions& opt, const std::string& source) {
+                                            const RigCalOptions& opt, const std::string& source,
+                                            const FrameCentreInfo* info) {
   if (auto v = validate_wand(wand, "wand"); !v) return v.error();
   const std::size_t C = intrinsics.size();
   if (auto v = check_camera_count(C, source); !v) return v.error();
@@ -166,6 +191,10 @@ Expected<RigCalResult> calibrate_from_blobs(const FrameBlobs& blobs, const WandS
                         "blobs of " + std::to_string(blobs[f].size()) + " cameras, the rig has " +
                             std::to_string(C));
   }
+  if (info && info->size() != blobs.size())
+    return make_error(
+        source, "centre info",
+        std::to_string(info->size()) + " frames, the blobs have " + std::to_string(blobs.size()));
   RigCalResult res;
   res.cameras = intrinsics;
   res.quality.resize(C);
@@ -174,19 +203,26 @@ Expected<RigCalResult> calibrate_from_blobs(const FrameBlobs& blobs, const WandS
   std::vector<WandFrame> frames;
   std::vector<int> order;
   std::vector<Vec2> scaled, px;
+  std::vector<std::size_t> slot;
   for (std::size_t f = 0; f < blobs.size(); ++f) {
     WandFrame wf;
     wf.frame = static_cast<int>(f);
     wf.px.resize(C);
+    // What is known of the centres, where given for every blob of the image.
+    if (info) wf.info.resize(C);
     for (std::size_t c = 0; c < C; ++c) {
       const CameraModel& cam = res.cameras[c];
+      const bool with_info =
+          info && (*info)[f].size() == C && (*info)[f][c].size() == blobs[f][c].size();
       scaled.clear();
       px.clear();
-      for (const Vec2& p : blobs[f][c]) {
+      slot.clear();
+      for (std::size_t i = 0; i < blobs[f][c].size(); ++i) {
         Vec2 xn;
-        if (!undistort_pixel(cam, p, xn)) continue;
+        if (!undistort_pixel(cam, blobs[f][c][i], xn)) continue;
         scaled.push_back(to_scaled(cam, xn));
-        px.push_back(p);
+        px.push_back(blobs[f][c][i]);
+        slot.push_back(i);
       }
       const LabelStatus s = label_wand(wand, opt.label, scaled, order);
       ++res.quality[c].label_status[static_cast<std::size_t>(s)];
@@ -194,6 +230,7 @@ Expected<RigCalResult> calibrate_from_blobs(const FrameBlobs& blobs, const WandS
       ++res.quality[c].frames_labelled;
       for (int i : order) {
         wf.px[c].push_back(px[static_cast<std::size_t>(i)]);
+        if (with_info) wf.info[c].push_back((*info)[f][c][slot[static_cast<std::size_t>(i)]]);
         res.quality[c].wand_points_px.push_back(px[static_cast<std::size_t>(i)]);
       }
     }
@@ -237,6 +274,7 @@ Expected<RigCalResult> calibrate_from_blobs(const FrameBlobs& blobs, const WandS
   // starts again from every frame: wrong intrinsics make good frames look like outliers.
   const std::vector<bool> use_initial = use;
   BundleOptions bo;
+  bo.weight_by_covariance = opt.weight_centres;
   auto st = bundle_adjust(wand, frames, use, res.cameras, poses, bo);
   if (!st) return Error{source + ": " + st.error().message};
   bo.refine_camera = refine_decision(res, *st, opt);

@@ -1,15 +1,17 @@
 // Design: the wand calibration of a rig of 2..8 cameras (kMinRigCameras..kMaxRigCameras),
 // end to end (`mocap calibrate-rig`):
 //  1. detect blobs in every frame of the wand recording (BlobDetector; merged, split
-//     and border blobs are dropped) and label the wand per image (wand_labeler.h); a
-//     frame takes part when the wand is labelled in at least two cameras;
+//     and border blobs are dropped, and less round ones unless they are wand balls
+//     whose edge is fitted), the centres and their covariances from the balls' edges
+//     (detect_recording), and label the wand per image (wand_labeler.h); a frame takes
+//     part when the wand is labelled in at least two cameras;
 //  2.-3. initial rig, pairwise from camera 0 (pairwise_init.h): per camera a RANSAC
 //     essential matrix with camera 0 (or, with too few shared frames, with the
 //     best-connected initialised camera), metric scale from the wand length, the inner
 //     markers' spacing checked against wand.yaml;
-//  4. one joint bundle adjustment (bundle.h) of every camera's pose but camera 0's and
-//     every wand pose, then, for each camera that the wand covered well in enough
-//     frames (or when asked), of its intrinsics and distortion too;
+//  4. one joint bundle adjustment (bundle.h, each centre weighed by its covariance) of
+//     every camera's pose but camera 0's and every wand pose, then, for each camera that the wand
+//     covered well in enough frames (or when asked), of its intrinsics and distortion too;
 //  5. quality: per camera reprojection RMS, frames, coverage, label statuses and pose
 //     relative to camera 0; wand-length error of independently triangulated ends
 //     (mean, RMS); warnings for too little coverage or too few frames;
@@ -46,6 +48,7 @@ struct RigCalOptions {
   bool edge_centres = true;     // balls' centres from their edges (detect_recording)
   double rod_cut_deg = 0.0;     // the wand rim left out on the rod's side: 0 = chosen from
                                 // the recording (wand_centres.h), > 0 = this (20..60)
+  bool weight_centres = true;   // the bundle weighs each centre by its covariance
   WandLabelConfig label{};
   IntrinsicsMode intrinsics = IntrinsicsMode::kAuto;
   int min_frames = 30;            // fewer frames with the wand in >= 2 cameras: error; also the
@@ -95,7 +98,8 @@ struct RigCalResult {
   std::vector<std::string> warnings;
   // How the wand balls' centres were found (set by the caller from detect_recording;
   // written to the report when end_ball_views > 0).
-  RodCutChoice wand_centres;
+  RodCutChoice wand_centres;                // whole end balls (detect_recording)
+  RodCutChoice wand_centres_partly_hidden;  // partly hidden end balls
 };
 
 // A rig calibration needs kMinRigCameras..kMaxRigCameras cameras; else the one-line
@@ -106,23 +110,27 @@ Expected<void> check_camera_count(std::size_t cameras, const std::string& record
 // were found.
 struct DetectedRecording {
   FrameBlobs blobs;
-  RodCutChoice rod_cut;  // end_ball_views = 0 without a wand or edge centres
+  FrameCentreInfo info;  // per centre: the edge fit's covariance, partly hidden or not
+  RodCutChoice rod_cut;  // whole end balls; end_ball_views = 0 without a wand or edge centres
+  RodCutChoice rod_cut_partly_hidden;  // the partly hidden end balls
 };
 
 // Detects blobs in every frame of a recording (every camera of its rig.yaml: 2..8, else
 // a one-line error naming the rig.yaml). Blobs that are merged, split or touch the
-// border are left out, and so are blobs less round than options.min_roundness x the
-// roundness a whole ball has at that place in the image (a ball's image is an ellipse
-// stretched radially by perspective and squeezed by barrel distortion,
-// expected_roundness()): a partly hidden marker has a biased centre. cams: the
+// border are left out. A blob less round than options.min_roundness x the roundness a
+// whole ball has at that place in the image (a ball's image is an ellipse stretched
+// radially by perspective and squeezed by barrel distortion, expected_roundness()) is
+// partly hidden and its centroid biased: it is kept only as a labelled wand ball whose
+// edge is fitted (with options.edge_centres and a wand; else it is left out). cams: the
 // intrinsics for that expectation (the recording's rig.yaml when null).
 // options.edge_centres: each kept blob's centre is its silhouette edge's
 // (detect/edge_centre.h, with the shape a whole ball has there), moved to the
-// projection of the ball's centre (ball_centre_pixel); the centroid stays where the
-// edge fit fails. wand (with options.label): the wand is labelled on the centroids of
-// each image and its balls' centres come from WandCentres (wand_centres.h: the rim
-// along the axis left out on the rod's side, the cut chosen from the recording unless
-// options.rod_cut_deg fixes it); null: no axis (an L-frame).
+// projection of the ball's centre (ball_centre_pixel), with the fit's covariance; the
+// centroid stays where the edge fit fails. wand (with options.label): the wand is
+// labelled on the centroids of each image (all kept blobs, else the round ones) and its
+// balls' centres come from WandCentres (wand_centres.h: the rim along the axis left out
+// on the rod's side, the cut chosen from the recording unless options.rod_cut_deg fixes
+// it); null: no axis (an L-frame).
 Expected<DetectedRecording> detect_recording(const std::string& dir, const RigCalOptions& options,
                                              const std::vector<CameraModel>* cams = nullptr,
                                              const WandSpec* wand = nullptr);
@@ -137,12 +145,14 @@ double expected_radial_stretch(const CameraModel& cam, const Vec2& px) noexcept;
 
 // The calibration from already detected blobs. intrinsics: the cameras' intrinsics
 // (2..8; names and sizes must be set; extrinsics ignored), blobs with one entry per
-// camera. source names the recording in errors (a wrong camera count names
-// source/rig.yaml).
+// camera. info (optional, the shape of blobs): the centres' covariances, which weigh the
+// bundle adjustment's residuals (BundleOptions::weight_by_covariance), and which are
+// partly hidden (left out of the wand-length figure). source names the
+// recording in errors (a wrong camera count names source/rig.yaml).
 Expected<RigCalResult> calibrate_from_blobs(const FrameBlobs& blobs, const WandSpec& wand,
                                             const std::vector<CameraModel>& intrinsics,
-                                            const RigCalOptions& options,
-                                            const std::string& source);
+                                            const RigCalOptions& options, const std::string& source,
+                                            const FrameCentreInfo* info = nullptr);
 
 // Sets the ground frame of a calibrated result from an L-frame recording's blobs.
 Expected<void> set_ground_frame(RigCalResult& result, const FrameBlobs& lframe_blobs,

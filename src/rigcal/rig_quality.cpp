@@ -120,9 +120,17 @@ Expected<void> fill_quality(RigCalResult& res, const WandSpec& wand,
     }
   }
   const std::size_t N = wand.markers_mm.size();
+  // A frame whose end balls are partly hidden in a camera (a cut rim: a noisier centre,
+  // weighed less in the bundle) is left out: the figure is the length's scatter over
+  // whole balls, comparable between recordings however much of the wand was hidden.
+  auto end_balls_whole = [&](const WandFrame& wf) {
+    for (const auto& cam : wf.info)
+      if (cam.size() == N && (cam.front().partly_hidden || cam.back().partly_hidden)) return false;
+    return true;
+  };
   double sum = 0.0, sum2 = 0.0;
   for (std::size_t f = 0; f < frames.size(); ++f) {
-    if (!use[f]) continue;
+    if (!use[f] || !end_balls_whole(frames[f])) continue;
     Vec3 a, b;
     if (!triangulate_marker(res.cameras, pair_geometry, frames[f], 0, a) ||
         !triangulate_marker(res.cameras, pair_geometry, frames[f], N - 1, b))

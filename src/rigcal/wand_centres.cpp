@@ -31,7 +31,8 @@ std::size_t choose_rod_cut(const RodCutChoice& f) {
 }
 
 bool WandCentres::add(const detect::EdgeSamples& samples, const CameraModel& cam, WandBallRole role,
-                      const Vec2& axis, std::size_t frame, std::size_t camera, std::size_t slot) {
+                      const Vec2& axis, std::size_t frame, std::size_t camera, std::size_t slot,
+                      bool partly_hidden) {
   const double n = axis.norm();
   if (!(n > 0.0)) return false;
   const Vec2 u = axis / n;
@@ -41,6 +42,7 @@ bool WandCentres::add(const detect::EdgeSamples& samples, const CameraModel& cam
   v.camera = camera;
   v.slot = slot;
   v.end = role != WandBallRole::kMiddle;
+  v.partly_hidden = partly_hidden;
   if (role == WandBallRole::kFirst) {  // the rod runs forward, the outside is behind
     ax.backward = detect::AxisSide::kChecked;
     v.away_from_rod = -u;
@@ -61,6 +63,7 @@ bool WandCentres::add(const detect::EdgeSamples& samples, const CameraModel& cam
     v.ok[j] = true;
     const Eigen::Matrix2d cov{{e.cov_xx_px2, e.cov_xy_px2}, {e.cov_xy_px2, e.cov_yy_px2}};
     v.var_along_px2[j] = u.dot(cov * u);
+    v.cov_px2[j] = cov;
     v.outer_used[j] = e.checked_used;
     any = true;
   }
@@ -69,12 +72,14 @@ bool WandCentres::add(const detect::EdgeSamples& samples, const CameraModel& cam
   return true;
 }
 
-RodCutChoice WandCentres::choose(double fixed_cut_deg) const {
+RodCutChoice WandCentres::choose(double fixed_cut_deg, bool partly_hidden) const {
   RodCutChoice out;
   std::array<double, kCuts> sum{}, sum_sq{}, sum_var{};
   std::array<int, kCuts> outer{};
   for (const View& v : views_) {
-    if (!v.end || std::find(v.ok.begin(), v.ok.end(), false) != v.ok.end()) continue;
+    if (!v.end || v.partly_hidden != partly_hidden ||
+        std::find(v.ok.begin(), v.ok.end(), false) != v.ok.end())
+      continue;
     ++out.end_ball_views;
     for (std::size_t j = 0; j < kCuts; ++j) {
       const double s = (v.centre_px[j] - v.centre_px[kReference]).dot(v.away_from_rod);
@@ -109,10 +114,17 @@ RodCutChoice WandCentres::choose(double fixed_cut_deg) const {
   return finish(choose_rod_cut(out));
 }
 
-void WandCentres::apply(const RodCutChoice& choice, FrameBlobs& blobs) const {
-  std::size_t chosen = 0;
-  while (chosen + 1 < kCuts && kRodCutsDeg[chosen] < choice.cut_deg) ++chosen;
+void WandCentres::apply(const RodCutChoice& choice, FrameBlobs& blobs, FrameCentreInfo* info,
+                        const RodCutChoice* partly_hidden) const {
+  auto index_of = [](const RodCutChoice& c) {
+    std::size_t j = 0;
+    while (j + 1 < kCuts && kRodCutsDeg[j] < c.cut_deg) ++j;
+    return j;
+  };
+  const std::size_t chosen_whole = index_of(choice);
+  const std::size_t chosen_hidden = index_of(partly_hidden ? *partly_hidden : choice);
   for (const View& v : views_) {
+    const std::size_t chosen = v.partly_hidden ? chosen_hidden : chosen_whole;
     // The chosen cut's centre, else the nearest wider one that fitted, else narrower.
     std::size_t j = chosen;
     while (j < kCuts && !v.ok[j]) ++j;
@@ -122,6 +134,7 @@ void WandCentres::apply(const RodCutChoice& choice, FrameBlobs& blobs) const {
     }
     if (!v.ok[j]) continue;
     blobs[v.frame][v.camera][v.slot] = v.centre_px[j];
+    if (info) (*info)[v.frame][v.camera][v.slot].cov_px2 = v.cov_px2[j];
   }
 }
 

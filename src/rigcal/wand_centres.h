@@ -80,24 +80,31 @@ class WandCentres {
   // One ball of a labelled wand in one image. blobs[frame][camera][slot] receives its
   // centre in apply(). axis: image direction from the wand's first ball to its last.
   // Returns false (nothing added) when the ball's edge could not be fitted: the slot
-  // keeps what the caller put there.
+  // keeps what the caller put there. partly_hidden: the ball's blob is less round than a
+  // whole ball's (its rim visibly cut); such views get a cut of their own.
   bool add(const detect::EdgeSamples& samples, const CameraModel& cam, WandBallRole role,
-           const Vec2& axis, std::size_t frame, std::size_t camera, std::size_t slot);
+           const Vec2& axis, std::size_t frame, std::size_t camera, std::size_t slot,
+           bool partly_hidden = false);
 
-  // The choice over the views added; fixed_cut_deg > 0 forces that cut (the nearest
-  // candidate).
-  RodCutChoice choose(double fixed_cut_deg) const;
+  // The choice over the views added (those partly hidden, or the others); fixed_cut_deg
+  // > 0 forces that cut (the nearest candidate).
+  RodCutChoice choose(double fixed_cut_deg, bool partly_hidden = false) const;
 
-  // Writes every added ball's centre for the chosen cut.
-  void apply(const RodCutChoice& choice, FrameBlobs& blobs) const;
+  // Writes every added ball's centre for its class's chosen cut (partly_hidden: that of
+  // the partly hidden views; null: `choice` for all) and, when info is given (the same
+  // shape as blobs), the edge fit's covariance of that centre (px^2).
+  void apply(const RodCutChoice& choice, FrameBlobs& blobs, FrameCentreInfo* info = nullptr,
+             const RodCutChoice* partly_hidden = nullptr) const;
 
  private:
   struct View {
     std::size_t frame = 0, camera = 0, slot = 0;
     bool end = false;
+    bool partly_hidden = false;
     std::array<bool, kRodCutsDeg.size()> outer_used{};  // the outer rim agreed
     Vec2 away_from_rod = Vec2::Zero();
     std::array<double, kRodCutsDeg.size()> var_along_px2{};
+    std::array<Eigen::Matrix2d, kRodCutsDeg.size()> cov_px2{};
     std::array<Vec2, kRodCutsDeg.size()> centre_px{};
     std::array<bool, kRodCutsDeg.size()> ok{};
   };

@@ -80,6 +80,16 @@ TEST(Report, YamlAndCoverageFiles) {
       << y;
   EXPECT_NE(y.find("               mean_shift_px: [0.00310, 0.00000, "), std::string::npos);
   EXPECT_NE(y.find("               cuts_deg: [20, 25, 30, "), std::string::npos);
+  EXPECT_EQ(y.find("wand_centres_partly_hidden"), std::string::npos);  // none
+  r.wand_centres_partly_hidden.end_ball_views = 60;
+  r.wand_centres_partly_hidden.cut_deg = 50.0;
+  r.wand_centres_partly_hidden.from_recording = true;
+  const std::string y2 = format_report_yaml(r, opt);
+  EXPECT_NE(y2.find("wand_centres_partly_hidden: {rod_cut_deg: 50, chosen_from_recording: true, "
+                    "end_ball_views: 60, outer_rim_used: 0.000,\n"
+                    "                             cuts_deg: [20, 25, 30, "),
+            std::string::npos)
+      << y2;
   EXPECT_NE(y.find("frames_total: 10"), std::string::npos);
   EXPECT_NE(y.find("camera_count: 2\n"), std::string::npos);
   EXPECT_NE(y.find("    t_cam_cam0_mm: [0.0000, 0.0000, 0.0000]\n"), std::string::npos) << y;
@@ -89,7 +99,7 @@ TEST(Report, YamlAndCoverageFiles) {
   EXPECT_EQ(cov.rgb[(0 * 32 + 0) * 3], 255);  // the dot at (1,1) -> (0,0)
   test::TempDir dir("rigcal_report");
   ASSERT_TRUE(write_report(dir.file("rep"), r, opt));
-  EXPECT_EQ(test::read_file(dir.file("rep/report.yaml")), y);
+  EXPECT_EQ(test::read_file(dir.file("rep/report.yaml")), y2);
   EXPECT_EQ(test::read_file(dir.file("rep/coverage_right.png")).substr(1, 3), "PNG");
 }
 

@@ -2,7 +2,8 @@
 // chooses the rod-side cut, and WandCentres on end balls drawn by tests/detect/synth.h
 // (not the simulator): with no rod the cut stays at its default and the outer rim is
 // used; a thick rod whose blurred flank reaches past the default widens the cut, and the
-// wider cut's centres are less biased than the default's.
+// wider cut's centres are less biased than the default's; partly hidden balls get a cut
+// of their own.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -47,15 +48,21 @@ struct Scene {
   double radius_px, rod_width_px, blur_px;
 };
 
-// n views of a recording's last wand ball (the rod behind it, nothing beyond), at random
-// sub-pixel positions and wand directions; returns the choice and the mean error of the
-// chosen centres and of the default cut's, outwards along the wand (px).
 struct Outcome {
   RodCutChoice choice;
   double chosen_outward_px = 0.0, default_outward_px = 0.0;
 };
 
-Outcome run(const Scene& sc, int n, std::uint32_t seed) {
+// Views of a recording: each ball's true centre, the direction away from its rod, and
+// its slot in blobs (one frame per view).
+struct Views {
+  std::vector<Vec2> truth, away;
+  FrameBlobs blobs;
+};
+
+// Adds n views of sc to wc (flagged partly_hidden as given).
+void add_views(WandCentres& wc, Views& v, const Scene& sc, int n, std::uint32_t seed,
+               bool partly_hidden = false) {
   detect::test::SynthParams p;
   p.width = 32;
   p.height = 32;
@@ -68,13 +75,10 @@ Outcome run(const Scene& sc, int n, std::uint32_t seed) {
   cam.fx = cam.fy = 1.0e6;
   cam.cx = cam.cy = 15.5;
   auto det = detect::BlobDetector::create(detect::DetectorConfig{}, p.width, p.height);
-  EXPECT_TRUE(static_cast<bool>(det));
+  ASSERT_TRUE(static_cast<bool>(det));
   detect::BlobList list = det->make_blob_list();
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> sub(-0.5, 0.5), angle(-M_PI, M_PI);
-  WandCentres wc;
-  std::vector<Vec2> truth, away;
-  FrameBlobs blobs;
   for (int i = 0; i < n; ++i) {
     p.seed = seed + static_cast<std::uint32_t>(i);
     const double x = 15.5 + sub(rng), y = 15.5 + sub(rng), phi = angle(rng);
@@ -88,27 +92,40 @@ Outcome run(const Scene& sc, int n, std::uint32_t seed) {
     // The rod leaves the ball at phi: the wand's axis (first ball -> last) points the
     // other way, and this is the last ball.
     const Vec2 axis(-std::cos(phi), -std::sin(phi));
-    const std::size_t f = blobs.size();
-    blobs.push_back({{Vec2(list[0].x_px, list[0].y_px)}});
-    if (!wc.add(samples, cam, WandBallRole::kLast, axis, f, 0, 0)) {
-      blobs.pop_back();
+    const std::size_t f = v.blobs.size();
+    v.blobs.push_back({{Vec2(list[0].x_px, list[0].y_px)}});
+    if (!wc.add(samples, cam, WandBallRole::kLast, axis, f, 0, 0, partly_hidden)) {
+      v.blobs.pop_back();
       continue;
     }
-    truth.emplace_back(x, y);
-    away.push_back(axis);
+    v.truth.emplace_back(x, y);
+    v.away.push_back(axis);
   }
+}
+
+// Mean error of views [first, last) of blobs, outwards along the wand (px).
+double outward_px(const Views& v, const FrameBlobs& blobs, std::size_t first, std::size_t last) {
+  double sum = 0.0;
+  for (std::size_t i = first; i < last; ++i) sum += (blobs[i][0][0] - v.truth[i]).dot(v.away[i]);
+  return last > first ? sum / static_cast<double>(last - first) : 0.0;
+}
+
+// n views of a recording's last wand ball (the rod behind it, nothing beyond), at random
+// sub-pixel positions and wand directions; returns the choice and the mean error of the
+// chosen centres and of the default cut's, outwards along the wand (px).
+Outcome run(const Scene& sc, int n, std::uint32_t seed) {
+  WandCentres wc;
+  Views v;
+  add_views(wc, v, sc, n, seed);
   Outcome out;
   out.choice = wc.choose(0.0);
-  FrameBlobs at_default = blobs;
+  FrameBlobs chosen = v.blobs, at_default = v.blobs;
   RodCutChoice fixed = out.choice;
   fixed.cut_deg = kDefaultRodCutDeg;
-  wc.apply(out.choice, blobs);
+  wc.apply(out.choice, chosen);
   wc.apply(fixed, at_default);
-  const double views = static_cast<double>(truth.size());
-  for (std::size_t i = 0; i < truth.size(); ++i) {
-    out.chosen_outward_px += (blobs[i][0][0] - truth[i]).dot(away[i]) / views;
-    out.default_outward_px += (at_default[i][0][0] - truth[i]).dot(away[i]) / views;
-  }
+  out.chosen_outward_px = outward_px(v, chosen, 0, v.truth.size());
+  out.default_outward_px = outward_px(v, at_default, 0, v.truth.size());
   return out;
 }
 
@@ -131,6 +148,30 @@ TEST(WandCentres, ThickBlurredRodWidensTheCut) {
   EXPECT_GT(o.choice.mean_shift_px[index_of(kDefaultRodCutDeg)],
             kWidenSigmas * o.choice.standard_error_px[index_of(kDefaultRodCutDeg)]);
   EXPECT_LT(std::fabs(o.chosen_outward_px), 0.5 * std::fabs(o.default_outward_px));
+}
+
+// Whole balls (no rod to speak of) and partly hidden ones (a thick blurred rod) in one
+// recording: each class gets its own cut, and the partly hidden balls' centres are less
+// biased than with the whole balls' cut, which stays at the default.
+TEST(WandCentres, PartlyHiddenViewsGetTheirOwnCut) {
+  WandCentres wc;
+  Views v;
+  add_views(wc, v, {4.0, 0.0, 0.5}, 150, 31u, false);
+  const std::size_t whole = v.truth.size();
+  add_views(wc, v, {3.0, 2.7, 1.0}, 150, 37u, true);
+  const RodCutChoice w = wc.choose(0.0, false), h = wc.choose(0.0, true);
+  EXPECT_EQ(w.end_ball_views, static_cast<int>(whole));
+  // (views with every candidate cut fitted: not all of the thick rod's)
+  EXPECT_GT(h.end_ball_views, 50);
+  EXPECT_LE(h.end_ball_views, static_cast<int>(v.truth.size() - whole));
+  EXPECT_EQ(w.cut_deg, kDefaultRodCutDeg);
+  EXPECT_GT(h.cut_deg, kDefaultRodCutDeg);
+  FrameBlobs own = v.blobs, one = v.blobs;
+  wc.apply(w, own, nullptr, &h);
+  wc.apply(w, one);
+  for (std::size_t i = 0; i < whole; ++i) EXPECT_EQ(own[i][0][0], one[i][0][0]);
+  EXPECT_LT(std::fabs(outward_px(v, own, whole, v.truth.size())),
+            0.5 * std::fabs(outward_px(v, one, whole, v.truth.size())));
 }
 
 TEST(WandCentres, FixedCutAndTooFewViews) {
