@@ -122,18 +122,24 @@ int WandFrame::cameras_labelled() const noexcept {
 }
 
 bool wand_residuals(const std::vector<CameraModel>& cams, const WandSpec& wand,
-                    const WandFrame& obs, const WandPose& pose, std::vector<double>& err_px,
-                    std::vector<int>* camera) {
-  err_px.clear();
-  if (camera) camera->clear();
+                    const WandFrame& obs, const WandPose& pose,
+                    const std::vector<std::vector<Eigen::Matrix2d>>& weight,
+                    std::vector<WandResidual>& out) {
+  out.clear();
   for (std::size_t c = 0; c < cams.size() && c < obs.px.size(); ++c) {
     if (obs.px[c].empty()) continue;
-    for (std::size_t k = 0; k < wand.markers_mm.size(); ++k) {
+    for (std::size_t k = 0; k < wand.markers_mm.size() && k < obs.px[c].size(); ++k) {
       const Vec3 X = pose.A + (wand.markers_mm[k] - wand.markers_mm[0]) * pose.d;
       Vec2 px;
       if (!project(cams[c], X, px)) return false;
-      err_px.push_back((px - obs.px[c][k]).norm());
-      if (camera) camera->push_back(static_cast<int>(c));
+      const Vec2 e = px - obs.px[c][k];
+      WandResidual r;
+      r.px = e.norm();
+      r.weighted = c < weight.size() && k < weight[c].size() ? (weight[c][k] * e).norm() : r.px;
+      r.camera = static_cast<int>(c);
+      r.partly_hidden =
+          c < obs.info.size() && k < obs.info[c].size() && obs.info[c][k].partly_hidden;
+      out.push_back(r);
     }
   }
   return true;
@@ -156,8 +162,7 @@ Expected<BundleStats> bundle_adjust(const WandSpec& wand, const std::vector<Wand
     if (frames[f].cameras_labelled() < 2) use[f] = false;
   }
   BundleStats stats;
-  std::vector<double> err;
-  std::vector<int> err_cam;
+  std::vector<WandResidual> err;
   const auto weights = centre_weights(frames, wand.markers_mm.size(), options.weight_by_covariance);
   for (int round = 0; round < std::max(1, options.rounds); ++round) {
     std::vector<std::array<double, 9>> intr(C);
@@ -248,9 +253,9 @@ Expected<BundleStats> bundle_adjust(const WandSpec& wand, const std::vector<Wand
       double ss = 0.0;
       int count = 0;
       for (std::size_t f = 0; f < frames.size(); ++f) {
-        if (!use[f] || !wand_residuals(cams, wand, frames[f], poses[f], err)) continue;
-        for (double e : err) {
-          ss += e * e;
+        if (!use[f] || !wand_residuals(cams, wand, frames[f], poses[f], weights[f], err)) continue;
+        for (const WandResidual& e : err) {
+          ss += e.weighted * e.weighted;
           ++count;
         }
       }
@@ -259,19 +264,20 @@ Expected<BundleStats> bundle_adjust(const WandSpec& wand, const std::vector<Wand
           std::clamp(options.outlier_sigmas * rms, options.outlier_min_px, options.outlier_px);
       for (std::size_t f = 0; f < frames.size(); ++f) {
         if (!use[f]) continue;
-        if (!wand_residuals(cams, wand, frames[f], poses[f], err)) {
+        if (!wand_residuals(cams, wand, frames[f], poses[f], weights[f], err)) {
           use[f] = false;
           continue;
         }
-        for (double e : err) {
-          if (e > limit) use[f] = false;
+        for (const WandResidual& e : err) {
+          if (e.weighted > limit) use[f] = false;
         }
       }
     }
   }
-  // Statistics over the frames in use.
-  std::vector<double> sum(C, 0.0);
-  std::vector<int> count(C, 0);
+  // Statistics over the frames in use: per camera over the whole balls, or over all
+  // when a camera has none (a partly hidden ball's noise says little of the rig).
+  std::vector<double> sum(C, 0.0), sum_all(C, 0.0);
+  std::vector<int> count(C, 0), count_all(C, 0);
   stats.frames_per_camera.assign(C, 0);
   stats.frames_used = 0;
   for (std::size_t f = 0; f < frames.size(); ++f) {
@@ -282,16 +288,22 @@ Expected<BundleStats> bundle_adjust(const WandSpec& wand, const std::vector<Wand
     ++stats.frames_used;
     for (std::size_t c = 0; c < C; ++c)
       stats.frames_per_camera[c] += frames[f].px[c].empty() ? 0 : 1;
-    if (!wand_residuals(cams, wand, frames[f], poses[f], err, &err_cam)) continue;
-    for (std::size_t i = 0; i < err.size(); ++i) {
-      const auto c = static_cast<std::size_t>(err_cam[i]);
-      sum[c] += err[i] * err[i];
+    if (!wand_residuals(cams, wand, frames[f], poses[f], weights[f], err)) continue;
+    for (const WandResidual& e : err) {
+      const auto c = static_cast<std::size_t>(e.camera);
+      sum_all[c] += e.px * e.px;
+      ++count_all[c];
+      if (e.partly_hidden) continue;
+      sum[c] += e.px * e.px;
       ++count[c];
     }
   }
   stats.rms_px.assign(C, 0.0);
-  for (std::size_t c = 0; c < C; ++c)
-    stats.rms_px[c] = count[c] > 0 ? std::sqrt(sum[c] / count[c]) : 0.0;
+  for (std::size_t c = 0; c < C; ++c) {
+    stats.rms_px[c] = count[c] > 0       ? std::sqrt(sum[c] / count[c])
+                      : count_all[c] > 0 ? std::sqrt(sum_all[c] / count_all[c])
+                                         : 0.0;
+  }
   return stats;
 }
 

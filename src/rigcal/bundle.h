@@ -60,7 +60,8 @@ struct BundleOptions {
   bool weight_by_covariance = true;
   double huber_px = 1.0;
   // Frames with a marker residual above clamp(outlier_sigmas x RMS, outlier_min_px,
-  // outlier_px) after a round are dropped.
+  // outlier_px) after a round are dropped (residuals weighed as in the adjustment, so
+  // a noisy centre is held to its own noise).
   double outlier_px = 2.0;
   double outlier_min_px = 0.3;
   double outlier_sigmas = 5.0;
@@ -69,7 +70,8 @@ struct BundleOptions {
 };
 
 struct BundleStats {
-  std::vector<double> rms_px;          // reprojection RMS per camera over used frames
+  std::vector<double> rms_px;          // reprojection RMS per camera over the used frames' whole
+                                       // balls (all balls when a camera has no whole one)
   std::vector<int> frames_per_camera;  // used frames labelled in each camera
   int frames_used = 0;
   int frames_dropped = 0;
@@ -77,11 +79,22 @@ struct BundleStats {
   bool converged = false;
 };
 
-// Reprojection errors (px) of one frame, labelled cameras in order x N markers; camera
-// (optional) receives each error's camera index. False if a point is behind a camera.
+// One marker's reprojection error in one camera.
+struct WandResidual {
+  double px = 0.0;        // |projection - centre| in pixels
+  double weighted = 0.0;  // |W (projection - centre)|: in units of a median centre's noise
+                          // (= px without weights)
+  int camera = 0;
+  bool partly_hidden = false;  // the centre's (WandFrame::info)
+};
+
+// The reprojection errors of one frame, labelled cameras in order x N markers. weight:
+// per camera and marker (as WandFrame::px), or empty (weighted = px). False if a point
+// is behind a camera.
 bool wand_residuals(const std::vector<CameraModel>& cams, const WandSpec& wand,
-                    const WandFrame& obs, const WandPose& pose, std::vector<double>& err_px,
-                    std::vector<int>* camera = nullptr);
+                    const WandFrame& obs, const WandPose& pose,
+                    const std::vector<std::vector<Eigen::Matrix2d>>& weight,
+                    std::vector<WandResidual>& out);
 
 // cams: initial values in, estimates out (cams[0] must be at the identity pose).
 // poses: one per frame, initial values in, estimates out. use: which frames take part
