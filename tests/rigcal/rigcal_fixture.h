@@ -1,12 +1,13 @@
 // Design: synthetic wand observations for the rig calibration tests: the simulator's
 // true rig, a wand moved on the simulator's path, and its markers projected through
-// the true cameras with Gaussian pixel noise (no rendering: fast under sanitizers).
-// For rigs of more than two cameras: a ring of cameras around a robot (ring_cameras)
-// and a wand waved at random poses in front of the robot, hidden from a camera at
-// random (ring_wand_blobs).
+// the true cameras with Gaussian pixel noise (no rendering: fast under sanitizers), all
+// by one generator (wand_blobs) along a path: the simulator's (synthetic_wand_blobs) or,
+// for rigs of more than two cameras, random poses in front of a robot seen by a ring of
+// cameras (ring_cameras, ring_wand_blobs), hidden from a camera at random.
 #pragma once
 
 #include <cmath>
+#include <functional>
 #include <random>
 #include <string>
 #include <vector>
@@ -49,37 +50,6 @@ inline std::vector<CameraModel> cam0_world(std::vector<CameraModel> cams) {
     c.t_cam_world = T.translation();
   }
   return cams;
-}
-
-// Blobs per frame: the wand's projections (+ noise) where inside the image, plus
-// `strays` random points per image.
-inline rigcal::FrameBlobs synthetic_wand_blobs(const std::vector<CameraModel>& cams,
-                                               const WandSpec& wand, int frames, double noise_px,
-                                               int strays, std::uint64_t seed) {
-  std::mt19937_64 rng(seed);
-  std::normal_distribution<double> noise(0.0, noise_px);
-  std::uniform_real_distribution<double> ux(0.0, 1.0);
-  rigcal::FrameBlobs out(static_cast<std::size_t>(frames),
-                         std::vector<std::vector<Vec2>>(cams.size()));
-  const double mid = 0.5 * (wand.markers_mm.front() + wand.markers_mm.back());
-  for (int f = 0; f < frames; ++f) {
-    const Iso3 T = sim::wand_pose(f, frames, seed);
-    for (std::size_t c = 0; c < cams.size(); ++c) {
-      for (double s : wand.markers_mm) {
-        Vec2 px;
-        if (!project(cams[c], T * Vec3(s - mid, 0, 0), px)) continue;
-        px += Vec2(noise(rng), noise(rng));
-        if (px.x() < 5 || px.y() < 5 || px.x() > cams[c].width - 6 || px.y() > cams[c].height - 6)
-          continue;
-        out[static_cast<std::size_t>(f)][c].push_back(px);
-      }
-      for (int k = 0; k < strays; ++k) {
-        out[static_cast<std::size_t>(f)][c].push_back(
-            Vec2(ux(rng) * cams[c].width, ux(rng) * cams[c].height));
-      }
-    }
-  }
-  return out;
 }
 
 // n cameras on a ring around a robot standing at the origin (Z up): 2.0..3.0 m from
@@ -127,34 +97,61 @@ inline Iso3 ring_wand_pose(std::mt19937_64& rng) {
   return make_iso(R, centre);
 }
 
-// Blobs per frame for a ring rig: the wand's projections (+ Gaussian noise_px) where
-// inside the image; in each camera the whole wand is hidden with probability p_hidden
-// (the robot in the way).
-inline rigcal::FrameBlobs ring_wand_blobs(const std::vector<CameraModel>& cams,
-                                          const WandSpec& wand, int frames, double noise_px,
-                                          double p_hidden, std::uint64_t seed) {
+// Where the wand is in frame f (marker 0 at -mid along its axis), drawn from rng or not.
+using WandPath = std::function<Iso3(int f, std::mt19937_64& rng)>;
+
+// The one generator of wand blobs: per frame the wand's pose from `path`; per camera the
+// whole wand hidden with probability p_hidden (the robot in the way; drawn only when
+// p_hidden > 0); each marker projected with Gaussian noise of noise_px per axis, kept
+// when at least 5 px inside the image; then `strays` random points per image.
+inline rigcal::FrameBlobs wand_blobs(const std::vector<CameraModel>& cams, const WandSpec& wand,
+                                     int frames, const WandPath& path, double noise_px,
+                                     double p_hidden, int strays, std::uint64_t seed) {
   std::mt19937_64 rng(seed);
-  std::normal_distribution<double> noise(0.0, noise_px);
+  // Drawn also without noise (noise_px = 0), so the draws stay those of any noise.
+  std::normal_distribution<double> noise(0.0, noise_px > 0.0 ? noise_px : 1.0);
   std::uniform_real_distribution<double> u01(0.0, 1.0);
   rigcal::FrameBlobs out(static_cast<std::size_t>(frames),
                          std::vector<std::vector<Vec2>>(cams.size()));
   const double mid = 0.5 * (wand.markers_mm.front() + wand.markers_mm.back());
   for (int f = 0; f < frames; ++f) {
-    const Iso3 T = ring_wand_pose(rng);
+    const Iso3 T = path(f, rng);
+    auto& frame = out[static_cast<std::size_t>(f)];
     for (std::size_t c = 0; c < cams.size(); ++c) {
-      const bool hidden = u01(rng) < p_hidden;
+      const bool hidden = p_hidden > 0.0 && u01(rng) < p_hidden;
       for (double s : wand.markers_mm) {
         Vec2 px;
         if (!project(cams[c], T * Vec3(s - mid, 0, 0), px)) continue;
-        px += Vec2(noise(rng), noise(rng));
+        const Vec2 n(noise(rng), noise(rng));
+        if (noise_px > 0.0) px += n;
         if (hidden || px.x() < 5 || px.y() < 5 || px.x() > cams[c].width - 6 ||
             px.y() > cams[c].height - 6)
           continue;
-        out[static_cast<std::size_t>(f)][c].push_back(px);
+        frame[c].push_back(px);
       }
+      for (int k = 0; k < strays; ++k)
+        frame[c].push_back(Vec2(u01(rng) * cams[c].width, u01(rng) * cams[c].height));
     }
   }
   return out;
+}
+
+// The pair's wand on the simulator's path (sim::wand_pose), with `strays` random
+// points per image.
+inline rigcal::FrameBlobs synthetic_wand_blobs(const std::vector<CameraModel>& cams,
+                                               const WandSpec& wand, int frames, double noise_px,
+                                               int strays, std::uint64_t seed) {
+  const WandPath path = [&](int f, std::mt19937_64&) { return sim::wand_pose(f, frames, seed); };
+  return wand_blobs(cams, wand, frames, path, noise_px, 0.0, strays, seed);
+}
+
+// A ring rig's wand at random poses in front of the robot (ring_wand_pose), hidden from
+// each camera with probability p_hidden.
+inline rigcal::FrameBlobs ring_wand_blobs(const std::vector<CameraModel>& cams,
+                                          const WandSpec& wand, int frames, double noise_px,
+                                          double p_hidden, std::uint64_t seed) {
+  const WandPath path = [](int, std::mt19937_64& rng) { return ring_wand_pose(rng); };
+  return wand_blobs(cams, wand, frames, path, noise_px, p_hidden, 0, seed);
 }
 
 }  // namespace mocap::test
