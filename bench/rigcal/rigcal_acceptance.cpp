@@ -20,10 +20,12 @@
 // along the wand's axis on the rod's side; default axis, as mocap calibrate-rig),
 // RIGCAL_ROD_CUT = degrees (that cut instead of the one chosen from the recording),
 // RIGCAL_SIM_BLUR = px, RIGCAL_SIM_NOISE = DN (the renderer's PSF sigma and read noise
-// instead of the defaults: other lenses and sensors), RIGCAL_TRUTH_NOISE = sigma px (the wand
-// centres replaced by their true projections plus Gaussian noise: the noise floor of the geometry
-// and frame count), RIGCAL_WEIGHTS=0 (every centre weighs the same in the bundle adjustment). Each
-// run renders into its own folder under $TMPDIR (rigcal_acceptance_<seed>_<cameras>).
+// instead of the defaults: other lenses and sensors), RIGCAL_RIG = a rig.yaml rendered through
+// instead of the built-in cameras (CAMERAS must be its camera count; e.g. docs/rigs/),
+// RIGCAL_TRUTH_NOISE = sigma px (the wand centres replaced by their true projections plus Gaussian
+// noise: the noise floor of the geometry and frame count), RIGCAL_WEIGHTS=0 (every centre weighs
+// the same in the bundle adjustment). Each run renders into its own folder under $TMPDIR
+// (rigcal_acceptance_<seed>_<cameras>).
 #include <Eigen/Geometry>
 #include <chrono>
 #include <cmath>
@@ -87,6 +89,7 @@ int main(int argc, char** argv) {
   so.dropout = 0.02;
   if (const char* b = std::getenv("RIGCAL_SIM_BLUR")) so.blur_px = std::atof(b);
   if (const char* n = std::getenv("RIGCAL_SIM_NOISE")) so.noise_dn = std::atof(n);
+  if (const char* r = std::getenv("RIGCAL_RIG")) so.rig_path = r;  // CAMERAS must be its count
   so.cameras = cameras;
   auto t0 = std::chrono::steady_clock::now();
   auto w = sim::write_calibration_recording(so, sim::CalibObjectKind::kWand, dir + "/wand");

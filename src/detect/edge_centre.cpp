@@ -293,10 +293,7 @@ EdgeCentre fit_edge_centre(const EdgeSamples& s, const EdgeCentreConfig& cfg,
   const Eigen::Vector2d u(ux, uy);
   const Eigen::Matrix2d J =
       Eigen::Matrix2d::Identity() + (radial_stretch - 1.0) * u * u.transpose();
-  const Eigen::Matrix2d cov = J * fit.cov * J.transpose();
-  out.cov_xx_px2 = cov(0, 0);
-  out.cov_xy_px2 = cov(0, 1);
-  out.cov_yy_px2 = cov(1, 1);
+  out.cov_px2 = J * fit.cov * J.transpose();
   out.radius_px = fit.rad;
   out.inliers = fit.inliers;
   out.rms_px = fit.rms;
@@ -308,11 +305,8 @@ EdgeCentre edge_centre(const ImageView& img, const Blob& blob, double noise_dn, 
                        double radial_y, double radial_stretch, const EdgeCentreConfig& cfg,
                        EdgeAxis axis) noexcept {
   EdgeSamples samples;
-  if (!sample_edge(img, blob, noise_dn, radial_x, radial_y, radial_stretch, cfg, samples)) {
-    EdgeCentre none;
-    none.edge_points = samples.count;
-    return none;
-  }
+  if (!sample_edge(img, blob, noise_dn, radial_x, radial_y, radial_stretch, cfg, samples))
+    return {};
   return fit_edge_centre(samples, cfg, axis);
 }
 

@@ -40,6 +40,7 @@
 // tracker's hot path.
 #pragma once
 
+#include <Eigen/Core>
 #include <array>
 
 #include "core/image.h"
@@ -104,7 +105,7 @@ struct EdgeCentre {
   // The centre's covariance (image pixels^2): the fit's, from the inliers' residual
   // variance, widened for the rays being closer than a pixel along the rim (neighbouring
   // rays read the same pixels: about one independent edge sample per pixel of rim).
-  double cov_xx_px2 = 0.0, cov_xy_px2 = 0.0, cov_yy_px2 = 0.0;
+  Eigen::Matrix2d cov_px2 = Eigen::Matrix2d::Zero();
   bool checked_used = false;  // AxisSide::kChecked rays were used (they agreed)
 };
 

@@ -10,6 +10,8 @@
 #include <array>
 #include <cmath>
 
+#include "core/median.h"
+
 namespace mocap::rigcal {
 namespace {
 
@@ -90,10 +92,7 @@ std::vector<std::vector<std::vector<Eigen::Matrix2d>>> centre_weights(
         if (c.cov_px2.trace() > 0.0) v.push_back(0.5 * c.cov_px2.trace());
   std::vector<std::vector<std::vector<Eigen::Matrix2d>>> out(frames.size());
   double s2 = 0.0;
-  if (enabled && !v.empty()) {
-    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
-    s2 = v[v.size() / 2];
-  }
+  if (enabled && !v.empty()) s2 = median_in_place(v);
   for (std::size_t f = 0; f < frames.size(); ++f) {
     out[f].assign(frames[f].px.size(),
                   std::vector<Eigen::Matrix2d>(markers, Eigen::Matrix2d::Identity()));

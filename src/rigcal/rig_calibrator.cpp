@@ -166,7 +166,7 @@ Expected<DetectedRecording> detect_recording(const std::string& dir, const RigCa
         Vec2 ball;
         if (!ball_centre_pixel(cam, Vec2(e.x_px, e.y_px), e.radius_px, ball)) continue;
         centres.back() = ball;
-        info.back().cov_px2 << e.cov_xx_px2, e.cov_xy_px2, e.cov_xy_px2, e.cov_yy_px2;
+        info.back().cov_px2 = e.cov_px2;
       }
     }
   }

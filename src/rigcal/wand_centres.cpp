@@ -18,6 +18,14 @@ static_assert(kRodCutsDeg[kDefault] == kDefaultRodCutDeg);
 // Fewer end-ball views than this: too few to tell a bias; the cut stays at its default.
 constexpr int kMinViewsToChoose = 50;
 
+// The candidate nearest to a cut (degrees).
+std::size_t nearest_cut(double deg) {
+  std::size_t best = 0;
+  for (std::size_t j = 1; j < kCuts; ++j)
+    if (std::fabs(kRodCutsDeg[j] - deg) < std::fabs(kRodCutsDeg[best] - deg)) best = j;
+  return best;
+}
+
 }  // namespace
 
 std::size_t choose_rod_cut(const RodCutChoice& f) {
@@ -61,9 +69,7 @@ bool WandCentres::add(const detect::EdgeSamples& samples, const CameraModel& cam
     if (!ball_centre_pixel(cam, Vec2(e.x_px, e.y_px), e.radius_px, c)) c = Vec2(e.x_px, e.y_px);
     v.centre_px[j] = c;
     v.ok[j] = true;
-    const Eigen::Matrix2d cov{{e.cov_xx_px2, e.cov_xy_px2}, {e.cov_xy_px2, e.cov_yy_px2}};
-    v.var_along_px2[j] = u.dot(cov * u);
-    v.cov_px2[j] = cov;
+    v.cov_px2[j] = e.cov_px2;
     v.outer_used[j] = e.checked_used;
     any = true;
   }
@@ -85,7 +91,7 @@ RodCutChoice WandCentres::choose(double fixed_cut_deg, bool partly_hidden) const
       const double s = (v.centre_px[j] - v.centre_px[kReference]).dot(v.away_from_rod);
       sum[j] += s;
       sum_sq[j] += s * s;
-      sum_var[j] += v.var_along_px2[j];
+      sum_var[j] += v.away_from_rod.dot(v.cov_px2[j] * v.away_from_rod);
       outer[j] += v.outer_used[j] ? 1 : 0;
     }
   }
@@ -102,13 +108,7 @@ RodCutChoice WandCentres::choose(double fixed_cut_deg, bool partly_hidden) const
     out.standard_error_px[j] = std::sqrt(var / (n - 1));
     out.along_sd_px[j] = std::sqrt(sum_var[j] / n);
   }
-  if (fixed_cut_deg > 0.0) {
-    std::size_t best = 0;
-    for (std::size_t j = 1; j < kCuts; ++j)
-      if (std::fabs(kRodCutsDeg[j] - fixed_cut_deg) < std::fabs(kRodCutsDeg[best] - fixed_cut_deg))
-        best = j;
-    return finish(best);
-  }
+  if (fixed_cut_deg > 0.0) return finish(nearest_cut(fixed_cut_deg));
   if (out.end_ball_views < kMinViewsToChoose) return finish(kDefault);
   out.from_recording = true;
   return finish(choose_rod_cut(out));
@@ -116,13 +116,8 @@ RodCutChoice WandCentres::choose(double fixed_cut_deg, bool partly_hidden) const
 
 void WandCentres::apply(const RodCutChoice& choice, FrameBlobs& blobs, FrameCentreInfo* info,
                         const RodCutChoice* partly_hidden) const {
-  auto index_of = [](const RodCutChoice& c) {
-    std::size_t j = 0;
-    while (j + 1 < kCuts && kRodCutsDeg[j] < c.cut_deg) ++j;
-    return j;
-  };
-  const std::size_t chosen_whole = index_of(choice);
-  const std::size_t chosen_hidden = index_of(partly_hidden ? *partly_hidden : choice);
+  const std::size_t chosen_whole = nearest_cut(choice.cut_deg);
+  const std::size_t chosen_hidden = nearest_cut((partly_hidden ? *partly_hidden : choice).cut_deg);
   for (const View& v : views_) {
     const std::size_t chosen = v.partly_hidden ? chosen_hidden : chosen_whole;
     // The chosen cut's centre, else the nearest wider one that fitted, else narrower.

@@ -103,7 +103,6 @@ class WandCentres {
     bool partly_hidden = false;
     std::array<bool, kRodCutsDeg.size()> outer_used{};  // the outer rim agreed
     Vec2 away_from_rod = Vec2::Zero();
-    std::array<double, kRodCutsDeg.size()> var_along_px2{};
     std::array<Eigen::Matrix2d, kRodCutsDeg.size()> cov_px2{};
     std::array<Vec2, kRodCutsDeg.size()> centre_px{};
     std::array<bool, kRodCutsDeg.size()> ok{};
