@@ -38,9 +38,9 @@ Case make_case(const std::array<std::vector<int>, 3>& visible, const std::array<
   sim::SceneOptions options;
   options.kind = sim::SceneKind::kStalks;  // the marker indices below are this layout's
   c.scene = sim::build_shoulder_scene(options).value();
-  sim::JointConfig jc;
-  jc.shoulder_rad = Vec3(-20, -30, -20) * kRadPerDeg;
-  jc.elbow_rad = 30 * kRadPerDeg;
+  sim::JointConfig jc = sim::make_config(c.scene);
+  jc.q_rad[sim::kShoulderJoint] = Vec3(-20, -30, -20) * kRadPerDeg;
+  jc.q_rad[sim::kElbowJoint].x() = 30 * kRadPerDeg;
   sim::SceneState st = sim::make_state(c.scene);
   sim::apply_config(c.scene, jc, st);
   std::mt19937 rng(3);

@@ -1,6 +1,7 @@
 // Design: `mocap simulate --out DIR [options]`: parses the flags with CLI11 and calls
 // mocap::sim::write_simulated_recording (the library entry point); --scene picks the
-// marker layout, --cameras N renders through the built-in 2..8 cameras, --rig through a
+// robot and its marker layout (the shoulder rig's limbs or stalks, or the humanoid),
+// --cameras N renders through the built-in 2..8 cameras, --rig through a
 // user-given rig of 2..8 cameras. Errors are one line
 // on stderr with exit code 2; success prints a one-line summary on stdout.
 #include <cstdio>
@@ -27,12 +28,14 @@ void register_simulate(CLI::App& app, int& exit_code) {
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
       "simulate",
-      "Write a synthetic recording (2..8 cameras) of the shoulder test rig with ground truth");
+      "Write a synthetic recording (2..8 cameras) of the shoulder test rig or the humanoid "
+      "with ground truth");
   cmd->add_option("--out", args->out, "Output folder (created if needed)")->required();
   cmd->add_option("--frames", args->opt.frames, "Number of frames (default 100)");
   cmd->add_option("--scene", args->scene,
-                  "Marker layout: limbs (markers all around the limbs) | stalks (stress "
-                  "variant) (default limbs)");
+                  "Robot and marker layout: limbs (the shoulder rig, markers all around the "
+                  "limbs) | stalks (its stress variant) | humanoid (the whole-body robot, 15 "
+                  "bodies) (default limbs)");
   cmd->add_option("--rig", args->opt.rig_path,
                   "Render through this rig.yaml (2..8 cameras) instead of the built-in cameras");
   cmd->add_option_function<int>(
@@ -42,9 +45,11 @@ void register_simulate(CLI::App& app, int& exit_code) {
         args->cameras_given = true;
       },
       "Built-in cameras, 2..8: 2 = the stereo pair, 3..8 on an arc around the "
-      "robot (default 2; with --rig: the rig's count)");
-  cmd->add_option("--motion", args->motion,
-                  "smooth | poses | move400 | viewpoints | wand | lframe (default smooth)");
+      "robot (humanoid: on a ring all around it) (default 2, humanoid 8; with --rig: the "
+      "rig's count)");
+  cmd->add_option(
+      "--motion", args->motion,
+      "smooth | poses | move400 | viewpoints | explore | wand | lframe (default smooth)");
   cmd->add_option("--seed", args->seed, "Random seed of noise, drop-outs and strays (default 1)");
   cmd->add_option_function<double>(
       "--noise",

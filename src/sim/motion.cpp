@@ -1,7 +1,10 @@
-// Design: closed-form motion plans (see motion.h). Angles in radians; the commanded
-// shoulder angles are R_cmd = Rx(q0) Ry(q1) Rz(q2) in torso axes (q0 < 0 raises the
-// arm towards the cameras, q1 < 0 lifts it sideways away from the torso, q2 turns it
-// about its own axis); the elbow angle bends the forearm towards the cameras.
+// Design: closed-form motion plans (see motion.h). Angles in radians. The shoulder
+// rig's plans (smooth, poses) are its own: the commanded shoulder angles are
+// R_cmd = Rx(q0) Ry(q1) Rz(q2) in torso axes (q0 < 0 raises the arm towards the
+// cameras, q1 < 0 lifts it sideways away from the torso, q2 turns it about its own
+// axis); the elbow angle bends the forearm towards the cameras. Other scenes' smooth
+// and poses plans, and every scene's explore, come from the joint ranges
+// (motion_tree.h); move400 and viewpoints move any scene's fixed pose rigidly.
 #include "sim/motion.h"
 
 #include <algorithm>
@@ -11,6 +14,7 @@
 
 #include "core/rotation.h"
 #include "core/units.h"
+#include "sim/motion_tree.h"
 #include "sim/sim_rng.h"
 
 namespace mocap::sim {
@@ -18,27 +22,20 @@ namespace {
 
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
 
-double halton(int index, int base) {
-  double f = 1.0, r = 0.0;
-  for (int i = index; i > 0; i /= base) {
-    f /= base;
-    r += f * (i % base);
-  }
-  return r;
-}
-
 // Joint angles of the static motions (move400, viewpoints): a pose in which every target
 // shows at least 3 unoccluded, unmerged markers to both cameras at the reference position
 // (pose 0 of the `poses` motion), as the paper's accuracy experiment needs all three
 // targets in view. (With the elbow at 60 deg two lower-arm markers overlap in camera 1.)
-JointConfig fixed_pose() {
-  JointConfig c;
-  c.shoulder_rad = Vec3(-27.5, -38.0, -24.0) * kRadPerDeg;
-  c.elbow_rad = 23.0 * kRadPerDeg;
+// Other scenes: tree_fixed_pose (motion_tree.h).
+JointConfig fixed_pose(const SimScene& scene) {
+  if (scene.kind == SceneKind::kHumanoid) return tree_fixed_pose(scene);
+  JointConfig c = make_config(scene);
+  c.q_rad[kShoulderJoint] = Vec3(-27.5, -38.0, -24.0) * kRadPerDeg;
+  c.q_rad[kElbowJoint].x() = 23.0 * kRadPerDeg;
   return c;
 }
 
-void plan_smooth(const MotionSpec& spec, MotionPlan& plan) {
+void plan_smooth(const SimScene& scene, const MotionSpec& spec, MotionPlan& plan) {
   const double duration_s = spec.frames / spec.fps;
   // At least ~0.7..1.7 cycles over the recording, at most 1.5 Hz.
   const std::array<double, 4> cycles = {0.9, 1.3, 0.7, 1.7};
@@ -48,47 +45,35 @@ void plan_smooth(const MotionSpec& spec, MotionPlan& plan) {
     hz[i] = std::min(1.5, std::max(base_hz[i], cycles[i] / duration_s));
   for (int f = 0; f < spec.frames; ++f) {
     const double t = f / spec.fps;
-    JointConfig c;
-    c.shoulder_rad = Vec3(-25.0 + 40.0 * std::sin(kTwoPi * hz[0] * t + 0.3),
-                          -28.0 + 26.0 * std::sin(kTwoPi * hz[1] * t + 1.1),
-                          35.0 * std::sin(kTwoPi * hz[2] * t + 2.0)) *
-                     kRadPerDeg;
-    c.elbow_rad = (60.0 + 50.0 * std::sin(kTwoPi * hz[3] * t - 0.5)) * kRadPerDeg;
+    JointConfig c = make_config(scene);
+    c.q_rad[kShoulderJoint] = Vec3(-25.0 + 40.0 * std::sin(kTwoPi * hz[0] * t + 0.3),
+                                   -28.0 + 26.0 * std::sin(kTwoPi * hz[1] * t + 1.1),
+                                   35.0 * std::sin(kTwoPi * hz[2] * t + 2.0)) *
+                              kRadPerDeg;
+    c.q_rad[kElbowJoint].x() = (60.0 + 50.0 * std::sin(kTwoPi * hz[3] * t - 0.5)) * kRadPerDeg;
     plan.configs.push_back(c);
   }
   plan.segments.push_back(MotionSegment{"move", 0, spec.frames - 1, Vec3::Zero()});
 }
 
-void plan_poses(const MotionSpec& spec, MotionPlan& plan) {
+void plan_poses(const SimScene& scene, const MotionSpec& spec, MotionPlan& plan) {
   std::vector<JointConfig> poses;
   Rng rng(hash_mix(spec.seed, 0x706F736573ull));
   for (int k = 0; k < spec.poses; ++k) {
-    JointConfig c;
+    JointConfig c = make_config(scene);
     const double j0 = rng.uniform(-3.0, 3.0), j1 = rng.uniform(-3.0, 3.0);
     const double j2 = rng.uniform(-3.0, 3.0), j3 = rng.uniform(-3.0, 3.0);
-    c.shoulder_rad =
+    c.q_rad[kShoulderJoint] =
         Vec3(-70.0 + 85.0 * halton(k + 1, 2) + j0, -58.0 + 60.0 * halton(k + 1, 3) + j1,
              -40.0 + 80.0 * halton(k + 1, 5) + j2) *
         kRadPerDeg;
-    c.elbow_rad = (8.0 + 105.0 * halton(k + 1, 7) + j3) * kRadPerDeg;
+    c.q_rad[kElbowJoint].x() = (8.0 + 105.0 * halton(k + 1, 7) + j3) * kRadPerDeg;
     poses.push_back(c);
   }
-  for (int f = 0; f < spec.frames; ++f) {
-    plan.configs.push_back(
-        poses[static_cast<std::size_t>(static_cast<std::int64_t>(f) * spec.poses / spec.frames)]);
-  }
-  int first = 0;
-  for (int f = 1; f <= spec.frames; ++f) {
-    const auto k_prev = static_cast<std::int64_t>(f - 1) * spec.poses / spec.frames;
-    const auto k_cur = static_cast<std::int64_t>(f) * spec.poses / spec.frames;
-    if (f == spec.frames || k_cur != k_prev) {
-      plan.segments.push_back(MotionSegment{"hold", first, f - 1, Vec3::Zero()});
-      first = f;
-    }
-  }
+  hold_poses(poses, spec.frames, plan);
 }
 
-void plan_move400(const MotionSpec& spec, MotionPlan& plan) {
+void plan_move400(const SimScene& scene, const MotionSpec& spec, MotionPlan& plan) {
   const std::array<Vec3, 4> dirs = {Vec3(0.0, 1.0, 0.0), Vec3(0.4, 0.917, 0.0),
                                     Vec3(-0.4, 0.917, 0.0), Vec3(0.3, 0.8, 0.35)};
   const int n_moves = static_cast<int>(dirs.size());
@@ -109,7 +94,7 @@ void plan_move400(const MotionSpec& spec, MotionPlan& plan) {
         x = (f - move_first + 1.0) / (move_last - move_first + 2.0);
       }
       const double s = x * x * (3.0 - 2.0 * x);
-      JointConfig c = fixed_pose();
+      JointConfig c = fixed_pose(scene);
       c.T_world_robot = make_iso(Mat3::Identity(), start + s * (end - start));
       plan.configs.push_back(c);
     }
@@ -130,7 +115,7 @@ void plan_viewpoints(const SimScene& scene, const MotionSpec& spec, MotionPlan& 
     const Vec3 shift(60.0 * std::sin(kTwoPi * 0.5 * x), 120.0 * std::sin(kTwoPi * 0.9 * x + 1.0),
                      40.0 * std::sin(kTwoPi * 1.1 * x));
     const Mat3 R = rot_z(yaw) * rot_x(pitch) * rot_y(roll);
-    JointConfig cfg = fixed_pose();
+    JointConfig cfg = fixed_pose(scene);
     cfg.T_world_robot = make_iso(R, c + shift - R * c);
     plan.configs.push_back(cfg);
   }
@@ -149,17 +134,19 @@ const char* motion_name(MotionKind kind) noexcept {
       return "move400";
     case MotionKind::kViewpoints:
       return "viewpoints";
+    case MotionKind::kExplore:
+      return "explore";
   }
   return "smooth";
 }
 
 Expected<MotionKind> parse_motion(const std::string& name) {
-  for (MotionKind k :
-       {MotionKind::kSmooth, MotionKind::kPoses, MotionKind::kMove400, MotionKind::kViewpoints}) {
+  for (MotionKind k : {MotionKind::kSmooth, MotionKind::kPoses, MotionKind::kMove400,
+                       MotionKind::kViewpoints, MotionKind::kExplore}) {
     if (name == motion_name(k)) return k;
   }
   return make_error("simulate", "motion",
-                    "unknown motion '" + name + "' (smooth|poses|move400|viewpoints)");
+                    "unknown motion '" + name + "' (smooth|poses|move400|viewpoints|explore)");
 }
 
 Expected<MotionPlan> plan_motion(const SimScene& scene, const MotionSpec& spec) {
@@ -169,9 +156,17 @@ Expected<MotionPlan> plan_motion(const SimScene& scene, const MotionSpec& spec) 
     return make_error("simulate", "fps", "must be in (0, 100000]");
   MotionPlan plan;
   plan.configs.reserve(static_cast<std::size_t>(spec.frames));
+  const bool shoulder = scene.kind != SceneKind::kHumanoid;
   switch (spec.kind) {
     case MotionKind::kSmooth:
-      plan_smooth(spec, plan);
+      if (shoulder) {
+        plan_smooth(scene, spec, plan);
+      } else {
+        plan_tree_smooth(scene, spec, plan);
+      }
+      break;
+    case MotionKind::kExplore:
+      plan_tree_explore(scene, spec, plan);
       break;
     case MotionKind::kPoses:
       if (spec.poses < 1) return make_error("simulate", "poses", "must be >= 1");
@@ -179,12 +174,16 @@ Expected<MotionPlan> plan_motion(const SimScene& scene, const MotionSpec& spec) 
         return make_error(
             "simulate", "frames",
             "must be at least the number of poses (" + std::to_string(spec.poses) + ")");
-      plan_poses(spec, plan);
+      if (shoulder) {
+        plan_poses(scene, spec, plan);
+      } else {
+        plan_tree_poses(scene, spec, plan);
+      }
       break;
     case MotionKind::kMove400:
       if (spec.frames < 12)
         return make_error("simulate", "frames", "move400 needs at least 12 frames");
-      plan_move400(spec, plan);
+      plan_move400(scene, spec, plan);
       break;
     case MotionKind::kViewpoints:
       plan_viewpoints(scene, spec, plan);

@@ -10,6 +10,10 @@
 //  - viewpoints: fixed joint angles; the whole robot is rotated (yaw up to +-55 deg,
 //                pitch +-20, roll +-10) and translated rigidly relative to the cameras,
 //                like moving the camera (the paper's Table 1B).
+//  - explore:    every joint through (95 % of) its range at once, each degree of
+//                freedom on a sinusoid of its own frequency (at least one cycle over the
+//                recording), the root swaying: what `mocap discover` learns a robot from.
+// The humanoid's smooth and poses plans are the generic ones of motion_tree.h.
 // Segments tell which frame ranges are static holds (gt/segments.csv).
 #pragma once
 
@@ -22,7 +26,7 @@
 
 namespace mocap::sim {
 
-enum class MotionKind { kSmooth, kPoses, kMove400, kViewpoints };
+enum class MotionKind { kSmooth, kPoses, kMove400, kViewpoints, kExplore };
 
 const char* motion_name(MotionKind kind) noexcept;
 Expected<MotionKind> parse_motion(const std::string& name);

@@ -51,8 +51,8 @@ double inverse_normal_cdf(double p) {
 Expected<RenderWorkspace> RenderWorkspace::create(const SimScene& scene) {
   RenderWorkspace ws;
   const auto n_markers = static_cast<std::size_t>(scene.marker_count());
-  if (n_markers == 0 || n_markers > 64)
-    return make_error("simulate", "markers", "need 1..64 markers");
+  if (n_markers == 0 || n_markers > 256)
+    return make_error("simulate", "markers", "need 1..256 markers");
   int max_w = 0, max_h = 0;
   double min_f = 1e300;
   for (const CameraModel& cam : scene.rig.cameras) {

@@ -1,15 +1,21 @@
-// Design: the simulator's built-in scenario, the paper's shoulder test rig: three
-// rigid bodies (torso, upper_arm, lower_arm), each a set of capsules (limbs and the
-// posts that hold the 12 mm marker balls) carrying a marker target, a ball joint
-// (shoulder: torso -> upper_arm) and a hinge (elbow: upper_arm -> lower_arm), seen by a
-// verged stereo pair like the paper's, by 3..8 built-in cameras on an arc around the
-// robot (scene_cameras.h), or by a user-given rig of 2..8 cameras (scene_rig.h). Two marker
-// layouts (scene_layouts.h): `limbs` (default, markers all around each limb on short
-// bases) and `stalks` (the stress variant). SimScene is immutable after
-// build_shoulder_scene(); a SceneState (body poses + noise key) is what changes per
-// frame. apply_config() is the forward kinematics: allocation-free, noexcept.
-// World frame: X to the right as seen from the cameras, Y away from the cameras
-// (depth), Z up; millimetres. Body poses map body to world (X_world = T * X_body).
+// Design: the simulator's built-in robots. Every scene is a kinematic tree of rigid
+// bodies, each a set of capsules (limbs and the posts that hold the marker balls)
+// carrying a marker target, joined by ball and hinge joints (SimJoint, in topological
+// order from the root body), seen by built-in cameras or by a user-given rig of 2..8
+// cameras (scene_rig.h). Two robots:
+//  - the paper's shoulder test rig (build_shoulder_scene): three bodies (torso,
+//    upper_arm, lower_arm), a ball joint (shoulder) and a hinge (elbow), seen by a
+//    verged stereo pair like the paper's or by 3..8 cameras on an arc around it
+//    (scene_cameras.h); two marker layouts (scene_layouts.h): `limbs` (default, markers
+//    all around each limb on short bases) and `stalks` (the stress variant);
+//  - a whole-body humanoid (scene_humanoid.h, `--scene humanoid`): 15 bodies, 14 joints,
+//    71 markers, on a ring of 2..8 cameras around it.
+// SimScene is immutable after build_scene(); a SceneState (body poses + noise key) is
+// what changes per frame. apply_config() is the forward kinematics: allocation-free,
+// noexcept. A JointConfig commands each joint in its own command axes (SimJoint::
+// R_parent_cmd): a ball joint R_cmd = Rx(q0) Ry(q1) Rz(q2) about its centre, a hinge
+// the angle q0 about its axis (right-hand rule), both relative to the reference pose.
+// World frame: Z up, millimetres; body poses map body to world (X_world = T * X_body).
 #pragma once
 
 #include <array>
@@ -27,10 +33,26 @@
 
 namespace mocap::sim {
 
+// The shoulder rig's bodies and joints (indices into its targets and its tree).
 inline constexpr int kTorso = 0;
 inline constexpr int kUpperArm = 1;
 inline constexpr int kLowerArm = 2;
 inline constexpr int kBodyCount = 3;
+inline constexpr int kShoulderJoint = 0;
+inline constexpr int kElbowJoint = 1;
+
+// One joint of a scene's kinematic tree, in its parent's frame at the reference pose.
+struct SimJoint {
+  int parent = 0;  // body indices
+  int child = 1;
+  JointType type = JointType::kBall;
+  Vec3 center_parent = Vec3::Zero();           // the joint centre (a point on a hinge axis)
+  Vec3 axis_parent = Vec3::UnitX();            // hinge axis (unit)
+  Mat3 R_parent_cmd = Mat3::Identity();        // the axes a ball joint's command is given in
+  Iso3 T_parent_child_ref = Iso3::Identity();  // child pose at the reference configuration
+  Vec3 lower_rad = Vec3::Zero();               // range of the commanded angles (motions)
+  Vec3 upper_rad = Vec3::Zero();               // (a hinge uses x only)
+};
 
 // A capsule (segment a-b swept by a sphere), in its body's frame. Limbs and stalks are
 // dark (they image at the background level) and occlude what lies behind them.
@@ -77,10 +99,10 @@ struct ImagingParams {
 ImagingParams default_imaging(int bits, int maxval);
 
 struct SceneOptions {
-  SceneKind kind = SceneKind::kLimbs;  // marker layout
+  SceneKind kind = SceneKind::kLimbs;  // the robot and its marker layout
   std::optional<Rig> rig;              // user-given cameras (checked); none: the built-in ones
-  int cameras = 2;                     // built-in cameras (2..8; ignored with a rig)
-  std::string rig_source;              // names the user rig in errors (its file)
+  int cameras = 0;         // built-in cameras (2..8; 0: the scene's default; ignored with a rig)
+  std::string rig_source;  // names the user rig in errors (its file)
   std::uint64_t seed = 1;
   int stray_glints = 0;  // number of shiny spots on the limbs
   ImagingParams imaging{};
@@ -99,15 +121,15 @@ struct SimScene {
   // Flattened marker list: body and index within the body's target.
   std::vector<int> marker_body;
   std::vector<int> marker_index;
-  // Kinematic reference (parent-frame quantities at the reference configuration).
-  Vec3 shoulder_center_torso = Vec3::Zero();
-  Vec3 elbow_center_upper = Vec3::Zero();
-  Vec3 elbow_axis_upper = Vec3::UnitX();
-  Iso3 T_torso_upper_ref = Iso3::Identity();
-  Iso3 T_upper_lower_ref = Iso3::Identity();
+  // The kinematic tree: joints in topological order (a parent's pose is known before its
+  // children's), joint k is joints_true.joints[k]; root_body has no parent.
+  std::vector<SimJoint> tree;
+  int root_body = 0;
   // Where the whole-robot rigid motions (move400, viewpoints) rotate about (world).
   Vec3 robot_center_world = Vec3::Zero();
 
+  int body_count() const noexcept { return static_cast<int>(targets.bodies.size()); }
+  int joint_count() const noexcept { return static_cast<int>(tree.size()); }
   int marker_count() const noexcept { return static_cast<int>(marker_body.size()); }
   Vec3 marker_in_body(int m) const noexcept {
     return targets.bodies[static_cast<std::size_t>(marker_body[static_cast<std::size_t>(m)])]
@@ -115,22 +137,27 @@ struct SimScene {
   }
 };
 
-// The commanded configuration of the robot.
+// The commanded configuration of the robot: one command per joint of the scene's tree
+// (make_config sizes it; apply_config ignores a config of another size).
 struct JointConfig {
   Iso3 T_world_robot = Iso3::Identity();  // rigid motion of the whole robot (applied in world)
-  Vec3 shoulder_rad = Vec3::Zero();       // R_cmd = Rx(q0) Ry(q1) Rz(q2) in torso axes
-  double elbow_rad = 0.0;                 // about the elbow axis, right-hand rule
+  std::vector<Vec3> q_rad;                // per joint: ball (q0, q1, q2), hinge (q0, -, -)
 };
 
 struct SceneState {
-  std::vector<Iso3> T_world_body;  // sized kBodyCount at setup
+  std::vector<Iso3> T_world_body;  // sized body_count() at setup
   std::uint64_t noise_key = 0;     // per-frame key of every random decision
 };
 
+// The scene of options.kind: the shoulder rig (limbs, stalks) or the humanoid.
+Expected<SimScene> build_scene(const SceneOptions& options);
 Expected<SimScene> build_shoulder_scene(const SceneOptions& options);
 
 // A state sized for the scene (setup; allocates).
 SceneState make_state(const SimScene& scene);
+
+// The reference configuration (every command 0), sized for the scene (setup; allocates).
+JointConfig make_config(const SimScene& scene);
 
 // Forward kinematics into a preallocated state (hot path).
 void apply_config(const SimScene& scene, const JointConfig& config, SceneState& state) noexcept;

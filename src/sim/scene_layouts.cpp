@@ -9,14 +9,22 @@
 namespace mocap::sim {
 
 const char* scene_name(SceneKind kind) noexcept {
-  return kind == SceneKind::kStalks ? "stalks" : "limbs";
+  switch (kind) {
+    case SceneKind::kStalks:
+      return "stalks";
+    case SceneKind::kHumanoid:
+      return "humanoid";
+    case SceneKind::kLimbs:
+      break;
+  }
+  return "limbs";
 }
 
 Expected<SceneKind> parse_scene(const std::string& name) {
-  for (SceneKind k : {SceneKind::kLimbs, SceneKind::kStalks}) {
+  for (SceneKind k : {SceneKind::kLimbs, SceneKind::kStalks, SceneKind::kHumanoid}) {
     if (name == scene_name(k)) return k;
   }
-  return make_error("simulate", "scene", "unknown scene '" + name + "' (limbs|stalks)");
+  return make_error("simulate", "scene", "unknown scene '" + name + "' (limbs|stalks|humanoid)");
 }
 
 const MarkerLayout& marker_layout(SceneKind kind) {

@@ -36,10 +36,11 @@
 
 namespace mocap::sim {
 
-enum class SceneKind : std::uint8_t { kLimbs, kStalks };
+// kHumanoid is the whole-body robot of scene_humanoid.h (its layout is its own).
+enum class SceneKind : std::uint8_t { kLimbs, kStalks, kHumanoid };
 
 const char* scene_name(SceneKind kind) noexcept;
-// "limbs" | "stalks"; error "simulate: scene: unknown scene 'x' (limbs|stalks)".
+// "limbs" | "stalks" | "humanoid"; error "simulate: scene: unknown scene 'x' (...)".
 Expected<SceneKind> parse_scene(const std::string& name);
 
 struct MarkerMount {

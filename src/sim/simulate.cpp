@@ -74,7 +74,7 @@ Expected<SimScene> make_scene(const SimOptions& o) {
     return make_error("simulate", "maxval", "must be 256..65535 for 16-bit output");
   SceneOptions so;
   so.kind = o.scene;
-  so.cameras = o.cameras == 0 ? 2 : o.cameras;
+  so.cameras = o.cameras;  // 0: the scene's default
   if (!o.rig_path.empty()) {
     auto rig = load_rig(o.rig_path);
     if (!rig) return rig.error();
@@ -96,7 +96,7 @@ Expected<SimScene> make_scene(const SimOptions& o) {
   so.imaging.blur_sigma_px = o.blur_px;
   so.imaging.dropout_probability = o.dropout;
   so.imaging.streak = o.streak;
-  return build_shoulder_scene(so);
+  return build_scene(so);
 }
 
 Expected<SimSummary> write_simulated_recording(const SimOptions& options, const std::string& dir,
@@ -158,7 +158,7 @@ Expected<SimSummary> write_simulated_recording(const SimOptions& options, const 
     });
     if (!rendered) return rendered.error();
     const std::int64_t ts = frames[static_cast<std::size_t>(f)].timestamp_ns;
-    for (int b = 0; b < kBodyCount; ++b) {
+    for (int b = 0; b < scene.body_count(); ++b) {
       const Iso3& T = state.T_world_body[static_cast<std::size_t>(b)];
       PoseRow row;
       row.frame = f;

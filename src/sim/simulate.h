@@ -1,4 +1,4 @@
-// Design: the library entry point of `mocap simulate`: builds the shoulder scene from
+// Design: the library entry point of `mocap simulate`: builds the scene from
 // SimOptions, plans the motion, renders every frame of every camera (2..8) and writes
 // the recording folder (spec: rig.yaml, frames.csv, cam0/, cam1/, ...), targets.yaml,
 // joints.yaml and the ground truth under gt/ (poses.csv, angles.csv, markers.csv,
@@ -18,9 +18,10 @@
 namespace mocap::sim {
 
 struct SimOptions {
-  SceneKind scene = SceneKind::kLimbs;  // marker layout (scene_layouts.h)
+  SceneKind scene = SceneKind::kLimbs;  // the robot and its layout (scene_layouts.h)
   std::string rig_path;                 // user rig (rig.yaml, 2..8 cameras) instead of the built-in
-  int cameras = 0;  // built-in cameras 2..8 (0: 2, the pair); with rig_path: 0 or its count
+  int cameras = 0;  // built-in cameras 2..8 (0: the scene's default: the pair, the humanoid's 8)
+                    // with rig_path: 0 or its count
   int frames = 100;
   MotionKind motion = MotionKind::kSmooth;
   std::uint64_t seed = 1;

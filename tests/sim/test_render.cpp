@@ -106,9 +106,9 @@ TEST(SimRender, SteadyStateRenderDoesNotAllocate) {
   ASSERT_TRUE(ws.ok());
   Image img = make_camera_image(*scene, 0);
   SceneState state = make_state(*scene);
-  JointConfig cfg;
-  cfg.shoulder_rad = Vec3(-0.3, -0.4, 0.2);
-  cfg.elbow_rad = 0.9;
+  JointConfig cfg = make_config(*scene);
+  cfg.q_rad[kShoulderJoint] = Vec3(-0.3, -0.4, 0.2);
+  cfg.q_rad[kElbowJoint].x() = 0.9;
   ASSERT_TRUE(render(*scene, state, 0, *ws, img));  // warm-up
   test::AllocationScope scope;
   for (int i = 0; i < 3; ++i) {

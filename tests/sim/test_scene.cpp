@@ -74,9 +74,10 @@ TEST(SimScene, DefaultIsTheLimbsLayoutAndNamesParse) {
   EXPECT_EQ(default_scene().kind, SceneKind::kLimbs);
   EXPECT_EQ(*parse_scene("limbs"), SceneKind::kLimbs);
   EXPECT_EQ(*parse_scene("stalks"), SceneKind::kStalks);
+  EXPECT_EQ(*parse_scene("humanoid"), SceneKind::kHumanoid);
   const auto bad = parse_scene("arms");
   ASSERT_FALSE(bad.ok());
-  EXPECT_EQ(bad.error().message, "simulate: scene: unknown scene 'arms' (limbs|stalks)");
+  EXPECT_EQ(bad.error().message, "simulate: scene: unknown scene 'arms' (limbs|stalks|humanoid)");
 }
 
 TEST(SimScene, IdentifierFindsNoAmbiguityInEitherLayout) {
@@ -207,7 +208,7 @@ TEST(SimScene, TrueModelIsConsistentWithTheKinematics) {
         (T[kUpperArm].linear() * el.axis_parent - T[kLowerArm].linear() * el.axis_child).norm(),
         1e-12);
     // Angles: hinge = the commanded elbow angle; ball = Euler XYZ of R_parent^T R_child.
-    EXPECT_NEAR(joint_angles_rad(el, T[kUpperArm], T[kLowerArm])[0], cfg.elbow_rad, 1e-9);
+    EXPECT_NEAR(joint_angles_rad(el, T[kUpperArm], T[kLowerArm])[0], cfg.q_rad[kElbowJoint].x(), 1e-9);
     const Vec3 a = joint_angles_rad(sh, T[kTorso], T[kUpperArm]);
     const Mat3 R_rel = T[kTorso].linear().transpose() * T[kUpperArm].linear();
     EXPECT_LT((euler_xyz_to_rotation(a) - R_rel).norm(), 1e-9);
@@ -217,8 +218,8 @@ TEST(SimScene, TrueModelIsConsistentWithTheKinematics) {
 TEST(SimScene, HingeAngleSignFollowsTheRightHandRule) {
   const SimScene s = default_scene();
   SceneState st = make_state(s);
-  JointConfig cfg;
-  cfg.elbow_rad = 0.5;
+  JointConfig cfg = make_config(s);
+  cfg.q_rad[kElbowJoint].x() = 0.5;
   apply_config(s, cfg, st);
   // Forearm tip moves towards the cameras (-Y) for a positive angle about axis (-X).
   const Vec3 tip_body = s.T_world_body_ref[kLowerArm].inverse() * Vec3(-60.0, 40.0, -235.0);
@@ -310,7 +311,8 @@ TEST(SimMotion, PosesAreDistinctAndHeld) {
     for (std::size_t j = 0; j < i; ++j) {
       const auto& a = plan->configs[static_cast<std::size_t>(seg.first_frame)];
       const auto& b = plan->configs[static_cast<std::size_t>(plan->segments[j].first_frame)];
-      EXPECT_GT((a.shoulder_rad - b.shoulder_rad).norm() + std::abs(a.elbow_rad - b.elbow_rad),
+      EXPECT_GT((a.q_rad[kShoulderJoint] - b.q_rad[kShoulderJoint]).norm() +
+                    std::abs(a.q_rad[kElbowJoint].x() - b.q_rad[kElbowJoint].x()),
                 5.0 * kRadPerDeg);
     }
   }

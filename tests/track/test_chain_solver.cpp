@@ -36,9 +36,9 @@ struct Fixture {
   }
 
   sim::SceneState pose(const Vec3& shoulder_deg, double elbow_deg) const {
-    sim::JointConfig jc;
-    jc.shoulder_rad = shoulder_deg * kRadPerDeg;
-    jc.elbow_rad = elbow_deg * kRadPerDeg;
+    sim::JointConfig jc = sim::make_config(scene);
+    jc.q_rad[sim::kShoulderJoint] = shoulder_deg * kRadPerDeg;
+    jc.q_rad[sim::kElbowJoint].x() = elbow_deg * kRadPerDeg;
     sim::SceneState st = sim::make_state(scene);
     sim::apply_config(scene, jc, st);
     return st;
