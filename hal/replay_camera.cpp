@@ -141,8 +141,9 @@ CameraStatus ReplayCamera::dequeue(Frame& out, int timeout_ms) noexcept {
   held_[b] = true;
   out.image = missing ? ImageView{} : image.view();
   out.sequence = sequence;
-  out.timestamp_ns = entry.timestamp_ns;
+  out.timestamp_ns = entry.timestamp_ns;  // the data's time: the recording's
   out.received_ns = monotonic_ns();
+  out.delivered_ns = out.received_ns;  // latencies start here (hal/camera.h, Frame)
   out.buffer_index = static_cast<std::uint32_t>(b);
   out.missing = missing;
   counters_.frames.add();

@@ -3,9 +3,12 @@
 // at start + timestamp_i - timestamp_0, CLOCK_MONOTONIC) or as fast as possible. Images
 // are read into a pool of buffer_count Images allocated at start(); the Frame views
 // one of them until release(). Frame sequence = the recording's frame number,
-// timestamp_ns = its timestamp_ns. A frame whose file is absent (or malformed, or of
-// the wrong pixel format) is delivered with missing = true and an empty image, and
-// the replay goes on; after the last frame dequeue returns kEndOfStream.
+// timestamp_ns = its timestamp_ns (the data's capture time, published unchanged),
+// delivered_ns = the CLOCK_MONOTONIC instant dequeue delivered it (image loaded): the
+// origin of the live pipeline's latencies (hal::latency_origin_ns). A frame whose file
+// is absent (or malformed, or of the wrong pixel format) is delivered with missing =
+// true and an empty image, and the replay goes on; after the last frame dequeue returns
+// kEndOfStream.
 // Trigger modes: kFreeRun (paced as above) and kSoftware (each trigger() releases
 // the next frame); kExternal falls back to kFreeRun with a notice. Exposure, gain and
 // frame rate are the recording's (notice).

@@ -73,13 +73,14 @@ void DetectStage::run() noexcept {
     }
     slot.sequence = f.sequence;
     slot.capture_ns = f.timestamp_ns;
-    const std::int64_t capture_ns = f.timestamp_ns;  // the slot is identify's once published
-    returned_.try_push(f);                           // the image is no longer needed
+    const std::int64_t origin_ns = hal::latency_origin_ns(f);
+    slot.origin_ns = origin_ns;  // (a local copy: the slot is identify's once published)
+    returned_.try_push(f);       // the image is no longer needed
     out_.publish(h);
     next.ring();
     const std::int64_t t1 = monotonic_ns();
     work_.record(t1 - t0);
-    latency_.record(t1 - capture_ns);
+    latency_.record(t1 - origin_ns);
   }
   context_.loop_end(id);
 }

@@ -7,9 +7,15 @@
 #include <numbers>
 
 #include "core/rotation.h"
-#include "track/labelled_markers.h"
 
 namespace mocap::pipeline {
+
+// Every output carries the whole robot (interfaces.md, "The whole robot"): nothing the
+// tracker produces is cut by the output record.
+static_assert(publish::kMaxResultBodies >= kMaxBodies, "FrameResult holds every body");
+static_assert(publish::kMaxResultMarkers >= kMaxLabelledMarkers, "and every labelled marker");
+static_assert(publish::kMaxResultPoints >= kMaxPoints, "and every point identification takes");
+static_assert(client::kMaxJoints >= kMaxBodies, "and every joint (chain_solver.cpp's bound)");
 
 void make_joints_message(std::uint64_t sequence, std::int64_t capture_ns, const FrameOutput& out,
                          client::JointsMessage& msg) noexcept {
@@ -47,7 +53,8 @@ void make_joints_message(std::uint64_t sequence, std::int64_t capture_ns, const 
 }
 
 void make_frame_result(std::uint64_t sequence, std::int64_t capture_ns, const TargetSet& targets,
-                       const FrameOutput& out, publish::FrameResult& result) noexcept {
+                       const FrameOutput& out, LabelledMarkers& labelled,
+                       publish::FrameResult& result) noexcept {
   make_joints_message(sequence, capture_ns, out, result.joints);
   const int bodies = std::min(
       {out.poses.count, publish::kMaxResultBodies, static_cast<int>(targets.bodies.size())});
@@ -80,7 +87,6 @@ void make_frame_result(std::uint64_t sequence, std::int64_t capture_ns, const Ta
     rb.t_world_body_mm = {t.x(), t.y(), t.z()};
   }
   // The labelled markers: the one list of the frame (track/labelled_markers.h).
-  LabelledMarkers labelled;  // on the stack: fixed size, no allocation
   label_markers(out, targets, labelled);
   for (int i = 0; i < labelled.count && markers < publish::kMaxResultMarkers; ++i) {
     const LabelledMarker& l = labelled.items[static_cast<std::size_t>(i)];

@@ -6,6 +6,10 @@
 // camera's blobs with what they became. Runs on the identify thread once per frame:
 // noexcept, allocation-free; anything beyond FrameResult's fixed capacities is left out.
 // The targets give the body and marker order and the model marker positions.
+// Capacities: FrameResult holds every body (kMaxBodies), labelled marker
+// (kMaxLabelledMarkers) and point (kMaxPoints) the tracker can produce, and every joint
+// (client::kMaxJoints >= the chain solver's bound) — static_asserts in the .cpp; only a
+// camera's blobs beyond kMaxResultBlobs are left out.
 #pragma once
 
 #include <cstdint>
@@ -14,6 +18,7 @@
 #include "formats/targets_yaml.h"
 #include "pipeline/publish/frame_result.h"
 #include "track/frame_processor.h"
+#include "track/labelled_markers.h"
 
 namespace mocap::pipeline {
 
@@ -23,7 +28,9 @@ void make_joints_message(std::uint64_t sequence, std::int64_t capture_ns, const 
                          client::JointsMessage& msg) noexcept;
 
 // Fills all of `result` (joints via make_joints_message); publish_ns is left 0.
+// `labelled` is the caller's workspace (preallocated: too big for a real-time stack).
 void make_frame_result(std::uint64_t sequence, std::int64_t capture_ns, const TargetSet& targets,
-                       const FrameOutput& out, publish::FrameResult& result) noexcept;
+                       const FrameOutput& out, LabelledMarkers& labelled,
+                       publish::FrameResult& result) noexcept;
 
 }  // namespace mocap::pipeline

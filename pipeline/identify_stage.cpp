@@ -112,7 +112,8 @@ void IdentifyStage::process(const hal::FramePair& set) noexcept {
   }
   const BlobSlot& first = (*inputs_[0])[set.cam[0].handle];
   const std::uint64_t sequence = first.sequence;
-  const std::int64_t capture_ns = first.capture_ns;
+  const std::int64_t capture_ns = first.capture_ns;  // the data's time: published as is
+  const std::int64_t origin_ns = first.origin_ns;    // the latencies' start
   release_set(set);
   processor_.process_blobs(capture_ns, out);
   library_.stereo.publish(kStereoFields, processor_.stereo_counters());
@@ -126,7 +127,8 @@ void IdentifyStage::process(const hal::FramePair& set) noexcept {
   if (o.observer) o.observer->observe(sequence, capture_ns, out);
   rt::SlotHandle m;
   if (out_.acquire(m)) {
-    make_frame_result(sequence, capture_ns, processor_.targets(), out, out_[m].frame);
+    make_frame_result(sequence, capture_ns, processor_.targets(), out, *labelled_, out_[m].frame);
+    out_[m].origin_ns = origin_ns;
     if ((out_[m].frame.joints.flags & client::kFlagAllBodiesFound) == 0)
       counters_.without_result.add();
     out_.publish(m);
@@ -137,7 +139,7 @@ void IdentifyStage::process(const hal::FramePair& set) noexcept {
   }
   const std::int64_t t1 = monotonic_ns();
   work_.record(t1 - t0);
-  latency_.record(t1 - capture_ns);
+  latency_.record(t1 - origin_ns);
 }
 
 void IdentifyStage::drain() noexcept {

@@ -10,6 +10,9 @@
 // capture, a detector or the pairer dropped them) are counted once each when the next
 // set forms (frames_unpaired): sets form in increasing sequence order. Every dropped
 // sequence is retired (StageContext::retire) so lockstep pacing goes on.
+// Latencies (identify, and publish's end to end) start at camera 0's latency origin
+// (hal::latency_origin_ns: the trigger, or a replay's delivery), carried in the slots;
+// the published capture_ns is the frame's own timestamp (a replay's: the recording's).
 // Its counters, the libraries' mirrored counters (stereo_*, identify_*, chain_*,
 // coverage_*) and its two histograms have this thread as only writer. run() is the hot
 // path: noexcept, allocation-free, lock-free, no logging.
@@ -27,6 +30,7 @@
 #include "rt/counter_group.h"
 #include "rt/slot_pool.h"
 #include "track/frame_processor.h"
+#include "track/labelled_markers.h"
 
 namespace mocap::pipeline {
 
@@ -72,8 +76,10 @@ class IdentifyStage {
   std::vector<std::unique_ptr<rt::SlotPool<BlobSlot>>> inputs_;
   hal::FramePairer pairer_;
   std::unique_ptr<FrameOutput> frame_;  // the frame being processed
-  std::uint64_t next_sequence_ = 0;     // the first sequence not yet accounted for
-  bool counting_ = false;               // next_sequence_ is set
+  // make_frame_result()'s workspace (kMaxLabelledMarkers entries, ~20 KiB: on the heap)
+  std::unique_ptr<LabelledMarkers> labelled_ = std::make_unique<LabelledMarkers>();
+  std::uint64_t next_sequence_ = 0;  // the first sequence not yet accounted for
+  bool counting_ = false;            // next_sequence_ is set
 
   struct alignas(64) Counters {
     rt::CounterGroup group;

@@ -19,9 +19,10 @@
 // Drop policy (the capture never blocks): each consumer drains its input and works on
 // the NEWEST item, returning the older ones (counted as skipped); a producer whose
 // consumer has stalled long enough to hold every slot drops the incoming item (counted).
-// Latency: every sample is measured from the frame's trigger timestamp (Frame.timestamp_ns)
-// on CLOCK_MONOTONIC: detect done, identify done, published (end to end), into
-// LatencyHistograms that any thread may read while the pipeline runs.
+// Latency: every sample is measured from the frame's latency origin on CLOCK_MONOTONIC
+// (hal::latency_origin_ns: a live camera's trigger timestamp, a replay's delivery; the
+// published capture_ns stays Frame.timestamp_ns): detect done, identify done, published
+// (end to end), into LatencyHistograms that any thread may read while the pipeline runs.
 // Health: health(), frames_published() and last_publish_ns() may be read from any thread.
 // Sources: pipeline.cpp (setup, start/stop), pipeline_stats.cpp (health, stats); the
 // stages in capture_stage, detect_stage, identify_stage and publish_stage.

@@ -38,6 +38,8 @@ void PublishStage::run() noexcept {
       skipped_seen = input_.skipped();
     }
     publish::FrameResult& frame = input_[h].frame;
+    const std::int64_t origin_ns = input_[h].origin_ns;  // latencies start here, not at
+                                                         // capture_ns (a replay's is old)
     const std::int64_t t0 = monotonic_ns();
     frame.joints.publish_ns = t0;
     std::int64_t t1 = t0;
@@ -48,7 +50,6 @@ void PublishStage::run() noexcept {
       t1 = t;
     }
     const std::uint64_t sequence = frame.joints.sequence;
-    const std::int64_t capture_ns = frame.joints.capture_ns;
     if (prev_publish_ns != 0) {  // publish period, exponential average over ~16 frames
       const std::int64_t ema = publish_period_ns_.load(std::memory_order_relaxed);
       const std::int64_t dt = t0 - prev_publish_ns;
@@ -57,7 +58,7 @@ void PublishStage::run() noexcept {
     }
     prev_publish_ns = t0;
     work_.record(t1 - t0);
-    end_to_end_.record(t0 - capture_ns);
+    end_to_end_.record(t0 - origin_ns);
     input_.release(h);
     // relaxed, then release: a reader that sees the new count (acquire) sees this time.
     last_publish_ns_.store(t0, std::memory_order_relaxed);

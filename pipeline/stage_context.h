@@ -28,12 +28,14 @@ inline constexpr std::int64_t kIdleWaitNs = 10'000'000;
 struct BlobSlot {
   detect::BlobList blobs;
   std::uint64_t sequence = 0;
-  std::int64_t capture_ns = 0;
-  bool present = false;  // false: the camera's frame was missing or empty
+  std::int64_t capture_ns = 0;  // the data's capture time (hal::Frame::timestamp_ns)
+  std::int64_t origin_ns = 0;   // where its latencies start (hal::latency_origin_ns)
+  bool present = false;         // false: the camera's frame was missing or empty
 };
 
 struct MsgSlot {
   publish::FrameResult frame;  // the frame's whole result, for every output sink
+  std::int64_t origin_ns = 0;  // camera 0's latency origin: the end-to-end latency's start
 };
 
 class StageContext {

@@ -18,11 +18,14 @@
 
 namespace mocap::publish {
 
-inline constexpr int kMaxResultBodies = 16;            // = identify's kMaxBodies
-inline constexpr int kMaxResultMarkers = 256;          // labelled markers per frame
-inline constexpr int kMaxResultPoints = 256;           // 3D points per frame (= kMaxPoints)
+// The compiled capacities of one frame's result (docs/formats.md, "Capacities", with their
+// memory: sizeof(FrameResult) is about 58 KiB). The builder (pipeline/
+// frame_result_builder.cpp) asserts that they hold everything the tracker produces.
+inline constexpr int kMaxResultBodies = 32;            // = identify's kMaxBodies
+inline constexpr int kMaxResultMarkers = 512;          // labelled markers per frame (32 x 16)
+inline constexpr int kMaxResultPoints = 512;           // 3D points per frame (= kMaxPoints)
 inline constexpr int kMaxResultCameras = kMaxCameras;  // cameras with blobs
-inline constexpr int kMaxResultBlobs = 64;             // blobs per camera
+inline constexpr int kMaxResultBlobs = 256;  // blobs per camera (= stereo max_points_per_camera)
 
 struct ResultBody {
   std::uint8_t found = 0;    // 1: the body was found in this frame
@@ -66,7 +69,7 @@ struct ResultBlob {
 };
 
 struct CameraBlobs {
-  std::int32_t count = 0;    // blobs[0, count); a camera with more keeps its first 64
+  std::int32_t count = 0;    // blobs[0, count); a camera with more keeps its first 256
   std::uint8_t present = 0;  // 1: the camera's frame arrived
   std::uint8_t reserved[3] = {0, 0, 0};
   std::array<ResultBlob, kMaxResultBlobs> blobs{};

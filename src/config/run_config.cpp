@@ -15,6 +15,7 @@
 #include "formats/rig_yaml.h"
 #include "formats/text_io.h"
 #include "formats/yaml_read.h"
+#include "sim/scene_humanoid.h"
 
 namespace mocap::config {
 
@@ -283,7 +284,7 @@ void read_identification(const YAML::Node& node, IdentifyConfig& c) {
       {"t_mm", "min_markers", "best_pairs", "ambiguity_ratio", "residual_floor_mm",
        "max_search_nodes", "temporal", "warm_gate_mm", "warm_min_markers", "max_prior_age_s",
        "max_speed_mm_per_s", "max_angular_speed_deg_per_s", "point_sigma_mm", "partial_sigma_mm",
-       "consistency_confidence", "exclude_partial_markers", "min_whole_markers"});
+       "consistency_confidence", "exclude_partial_markers", "min_whole_markers", "max_points"});
   set(c.t_mm, positive(s, "t_mm", 1000.0));
   set(c.min_markers, s.integer("min_markers", 3, 64));
   set(c.best_pairs, s.integer("best_pairs", 1, 100000));
@@ -301,6 +302,9 @@ void read_identification(const YAML::Node& node, IdentifyConfig& c) {
   set(c.consistency_confidence, s.number("consistency_confidence", 0.99, 0.999999));
   set(c.exclude_partial_markers, s.flag("exclude_partial_markers"));
   set(c.min_whole_markers, s.integer("min_whole_markers", 0, 16));
+  // 3D points per frame identification takes (its pair table costs 24 bytes x n^2/2 at
+  // setup: docs/formats.md, "Capacities"); bounded by the compiled kMaxPoints.
+  set(c.max_points, s.integer("max_points", 3, kMaxPoints));
 }
 
 Expected<RunConfig> parse(const std::string& path, const YAML::Node& root) {
@@ -325,7 +329,12 @@ Expected<RunConfig> parse(const std::string& path, const YAML::Node& root) {
   set(cfg.sim.loop_frames, sim.integer("loop_frames", kMinLoopFrames, kMaxLoopFrames));
   set(cfg.sim.scene,
       sim.choice<mocap::sim::SceneKind>("scene", {{"limbs", mocap::sim::SceneKind::kLimbs},
-                                                  {"stalks", mocap::sim::SceneKind::kStalks}}));
+                                                  {"stalks", mocap::sim::SceneKind::kStalks},
+                                                  {"humanoid", mocap::sim::SceneKind::kHumanoid}}));
+  const bool humanoid = cfg.sim.scene == mocap::sim::SceneKind::kHumanoid;
+  // The humanoid's loop: 8 x 1280x1024 images per frame (10.5 MB), so 100 frames by
+  // default (1 GB, pre-rendered at start).
+  if (humanoid && !sim.has("loop_frames")) cfg.sim.loop_frames = kHumanoidLoopFrames;
   for (const char* key : {"loop_frames", "scene", "cameras", "rig"}) {
     if (sim.has(key) && cfg.cameras[0].backend != CameraBackend::kSim)
       sim.bad(key, std::string("only used by the sim backend (cameras use ") +
@@ -334,6 +343,8 @@ Expected<RunConfig> parse(const std::string& path, const YAML::Node& root) {
   // The simulated camera count: sim.cameras, sim.rig's cameras or the length of the
   // cameras list (any of them, agreeing); kept as cfg.cameras.size() (its one home).
   std::optional<std::int64_t> sim_cameras = sim.integer("cameras", kMinCameras, kMaxCameras);
+  if (humanoid && !sim_cameras && !sim.has("rig") && !top.has("cameras"))
+    sim_cameras = mocap::sim::kHumanoidDefaultCameras;  // the humanoid's ring
   if (const auto v = sim.text("rig")) {
     cfg.sim.rig_path = resolve(base, *v);
     const auto rig = load_rig(cfg.sim.rig_path);

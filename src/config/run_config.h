@@ -90,7 +90,7 @@ struct OutputSettings {
 };
 
 struct SimSettings {
-  int loop_frames = 200;  // frames pre-rendered for the sim backend
+  int loop_frames = 200;  // frames pre-rendered for the sim backend (humanoid: 100)
   // The key `sim.cameras` (2..8, sim/scene_cameras.h: the stereo pair, or 3..8 on an arc
   // around the robot) sets RunConfig::cameras to that many sim cameras: the count's one
   // home is cameras.size().
@@ -135,6 +135,7 @@ struct RunConfig {
 // --loop-frames) are validated by these, so both accept exactly the same values.
 inline constexpr int kMinLoopFrames = 2;
 inline constexpr int kMaxLoopFrames = 2000;
+inline constexpr int kHumanoidLoopFrames = 100;  // sim.loop_frames' default for the humanoid
 // `where` names the key or flag in the error ("--rate: must be in [0.01, 10000] Hz, got 0").
 Expected<void> check_trigger_rate_hz(const std::string& where, double hz);
 Expected<void> check_loop_frames(const std::string& where, long long frames);

@@ -1,8 +1,13 @@
 // Design: see tracking_assets.h.
 #include "config/tracking_assets.h"
 
+#include <string>
+#include <vector>
+
+#include "client/joints_message.h"
 #include "formats/recording.h"
 #include "formats/rig_yaml.h"
+#include "identify/identify_types.h"
 #include "track/frame_processor.h"
 
 namespace mocap::config {
@@ -49,6 +54,12 @@ Expected<TrackingAssets> load_tracking_assets(const RunConfig& cfg, const Rig* n
   } else if (native_model != nullptr && cfg.targets_path.empty()) {
     a.model = *native_model;  // the native model belongs to the native targets
   }
+  if (auto r = check_capacities(
+          file, a,
+          cfg.targets_path.empty() ? std::string("the backend's targets") : cfg.targets_path,
+          cfg.model_path.empty() ? std::string("the backend's model") : cfg.model_path);
+      !r)
+    return r.error();
   // Every camera of the rig takes part (interfaces.md, "Extensions"): one configured
   // camera per rig camera, in rig order.
   if (a.rig.cameras.size() != cfg.cameras.size()) {
@@ -68,6 +79,33 @@ Expected<TrackingAssets> load_tracking_assets(const RunConfig& cfg, const Rig* n
     }
   }
   return a;
+}
+
+Expected<void> check_capacities(const std::string& file, const TrackingAssets& assets,
+                                const std::string& targets_file, const std::string& model_file) {
+  static_assert(client::kMaxJoints >= kMaxBodies, "every chain joint fits the message");
+  const auto n = [](std::size_t v) { return std::to_string(v); };
+  const std::vector<MarkerTarget>& bodies = assets.targets.bodies;
+  if (bodies.size() > static_cast<std::size_t>(kMaxBodies)) {
+    return make_error(file, "targets",
+                      targets_file + ": bodies: " + n(bodies.size()) + " bodies, at most " +
+                          n(kMaxBodies) + " (the compiled capacity kMaxBodies)");
+  }
+  for (std::size_t b = 0; b < bodies.size(); ++b) {
+    if (bodies[b].markers_body.size() > static_cast<std::size_t>(kMaxMarkers)) {
+      return make_error(file, "targets",
+                        targets_file + ": bodies[" + n(b) + "] '" + bodies[b].name +
+                            "': " + n(bodies[b].markers_body.size()) + " markers, at most " +
+                            n(kMaxMarkers) + " (the compiled capacity kMaxMarkers)");
+    }
+  }
+  if (assets.model && assets.model->joints.size() > static_cast<std::size_t>(kMaxBodies)) {
+    return make_error(file, "model",
+                      model_file + ": joints: " + n(assets.model->joints.size()) +
+                          " joints, at most " + n(kMaxBodies) +
+                          " (the compiled capacity kMaxBodies)");
+  }
+  return {};
 }
 
 Expected<void> check_tracking_assets(const RunConfig& cfg, bool targets_required) {

@@ -34,6 +34,14 @@ Expected<TrackingAssets> load_tracking_assets(const RunConfig& cfg, const Rig* n
                                               const JointModel* native_model,
                                               bool targets_required = true);
 
+// The compiled capacities the assets must fit (docs/formats.md, "Capacities"): at most
+// kMaxBodies bodies of at most kMaxMarkers markers each, and at most kMaxBodies joints
+// (every one fits the live message's client::kMaxJoints). One line naming the
+// configuration, its key and the file: "FILE: targets: T.yaml: bodies: 33 bodies, at
+// most 32 (the compiled capacity kMaxBodies)".
+Expected<void> check_capacities(const std::string& file, const TrackingAssets& assets,
+                                const std::string& targets_file, const std::string& model_file);
+
 // Load-time check: resolves the assets (building the sim scene or opening the replay
 // recording, both cheap), checks the configured camera sizes against the rig and
 // builds the tracker once with the configured thresholds.

@@ -9,10 +9,13 @@ Expected<ChainModel> ChainModel::create(const JointModel& model, const TargetSet
   ChainModel m;
   const int nb = static_cast<int>(targets.bodies.size());
   if (nb > kMaxBodies)
-    return make_error("targets.yaml", "bodies", "chain tracking supports at most 16 bodies");
+    return make_error("targets.yaml", "bodies",
+                      std::to_string(nb) + " bodies, chain tracking supports at most " +
+                          std::to_string(kMaxBodies));
   for (const MarkerTarget& t : targets.bodies) {
     if (static_cast<int>(t.markers_body.size()) > kMaxMarkers)
-      return make_error("targets.yaml", "bodies." + t.name, "more than 16 markers");
+      return make_error("targets.yaml", "bodies." + t.name,
+                        "more than " + std::to_string(kMaxMarkers) + " markers");
     m.markers_body_.push_back(t.markers_body);
   }
   m.joint_into_.assign(static_cast<std::size_t>(nb), -1);

@@ -26,7 +26,9 @@
 
 namespace mocap {
 
-// Degrees of freedom of a chain: 3 per ball joint, 1 per hinge.
+// Degrees of freedom of a chain: 3 per ball joint, 1 per hinge; a model of kMaxBodies
+// bodies has at most kMaxBodies chain joints (96 DOF). The solver's dense matrices are
+// kMaxChainDof^2 (chain_solver.h: on the heap).
 inline constexpr int kMaxChainDof = 3 * kMaxBodies;
 
 struct ChainJoint {

@@ -12,8 +12,7 @@
 namespace mocap {
 namespace {
 
-using MatX = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxChainDof, kMaxChainDof>;
-using VecX = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxChainDof, 1>;
+using VecX = chain_detail::DofVector;
 
 Mat3 skew(const Vec3& v) noexcept {
   Mat3 S;
@@ -46,7 +45,9 @@ Expected<ChainSolver> ChainSolver::create(ChainModel model, const ChainConfig& c
   if (!(config.max_sd_deg > 0.0)) return bad("max_sd_deg", "must be > 0");
   if (config.max_search_nodes < 16) return bad("max_search_nodes", "must be >= 16");
   if (model.joint_count() > kMaxBodies)
-    return make_error("model.yaml", "joints", "chain tracking supports at most 16 joints");
+    return make_error("model.yaml", "joints",
+                      std::to_string(model.joint_count()) +
+                          " joints, chain tracking supports at most " + std::to_string(kMaxBodies));
   return ChainSolver(std::move(model), config);
 }
 
@@ -89,14 +90,19 @@ bool ChainSolver::gauss_newton(const MeasuredPoint* pts, const BodyPoses& poses,
   chi2_ = 0.0;
   residual_markers_ = 0;
   if (ndof == 0) return true;
-  MatX H(ndof, ndof);
-  VecX g(ndof);
+  // The preallocated workspace (chain_solver.h): resizing within kMaxChainDof allocates
+  // nothing, and only the ndof x ndof block is touched.
+  chain_detail::NormalEquations& ne = *normal_;
+  chain_detail::DofMatrix& H = ne.H;
+  VecX& g = ne.g;
+  Eigen::LDLT<chain_detail::DofMatrix>& ldlt = ne.ldlt;
+  H.resize(ndof, ndof);
+  g.resize(ndof);
   struct Block {
     int offset, dof;
     Mat3 B;
   };
   std::array<Block, kMaxBodies> path{};
-  Eigen::LDLT<MatX> ldlt(ndof);
   for (int iter = 0; iter < 8; ++iter) {
     forward(poses, out);
     H.setZero();
@@ -182,15 +188,21 @@ bool ChainSolver::gauss_newton(const MeasuredPoint* pts, const BodyPoses& poses,
     }
   }
   dof_ = 3 * residual_markers_ - ndof;
-  MatX cov = ldlt.solve(MatX::Identity(ndof, ndof));
+  // The diagonal blocks of H^-1, one column per degree of freedom: vector solves, so no
+  // ndof^2 temporary and no blocked matrix solve (whose fixed-capacity scratch would be
+  // ~147 KiB of stack at kMaxChainDof = 96).
   for (const int j : model_.order()) {
     const auto uj = static_cast<std::size_t>(j);
     if (!active_[uj]) continue;
     const int o = dof_offset_[uj];
-    if (model_.joint(j).dof == 3)
-      cov_[uj] = cov.block<3, 3>(o, o);
-    else
-      sd_dof_[static_cast<std::size_t>(o)] = std::sqrt(std::max(0.0, cov(o, o)));
+    const int d = model_.joint(j).dof;
+    for (int k = 0; k < d; ++k) {
+      const VecX col = ldlt.solve(VecX::Unit(ndof, o + k));
+      if (d == 3)
+        cov_[uj].col(k) = col.segment<3>(o);
+      else
+        sd_dof_[static_cast<std::size_t>(o)] = std::sqrt(std::max(0.0, col[o]));
+    }
   }
   return true;
 }

@@ -31,10 +31,15 @@
 // its angles: from the chain solve's covariance, or, for joints whose two bodies were
 // found, from the rigid fits' rotation covariances (sigma^2 (sum |r|^2 I - r r^T)^-1 per
 // body, summed in the parent's frame).
+// Capacity: up to kMaxBodies joints (kMaxChainDof = 96 degrees of freedom). The dense
+// normal equations (two kMaxChainDof^2 matrices, ~144 KiB) live in a heap workspace
+// allocated at create(); a frame touches only its active joints' ndof^2 block of them.
 #pragma once
 
+#include <Eigen/Cholesky>
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "client/joints_message.h"
@@ -62,6 +67,39 @@ struct LabelSearch {
   bool hit_limit = false;
   bool pair_ok(int m, int p, int mm, int q) const noexcept;
   void visit(int m, int count) noexcept;
+};
+
+// Fixed-capacity dense storage: resized per frame up to kMaxChainDof without allocating.
+using DofMatrix =
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxChainDof, kMaxChainDof>;
+using DofVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxChainDof, 1>;
+// The normal equations of the joint solve and their factorisation (gauss_newton()).
+struct NormalEquations {
+  DofMatrix H;
+  DofVector g;
+  Eigen::LDLT<DofMatrix> ldlt;
+};
+// A T on the heap with value semantics: allocated at construction (setup), deep-copied
+// with its owner (setup code), never reallocated by the per-frame calls. A moved-from
+// HeapValue may only be destroyed or assigned to.
+template <typename T>
+class HeapValue {
+ public:
+  HeapValue() : p_(std::make_unique<T>()) {}
+  HeapValue(const HeapValue& o) : p_(o.p_ ? std::make_unique<T>(*o.p_) : std::make_unique<T>()) {}
+  HeapValue& operator=(const HeapValue& o) {
+    if (this == &o) return *this;
+    if (!o.p_) p_ = std::make_unique<T>();
+    else if (p_) *p_ = *o.p_;
+    else p_ = std::make_unique<T>(*o.p_);
+    return *this;
+  }
+  HeapValue(HeapValue&&) noexcept = default;
+  HeapValue& operator=(HeapValue&&) noexcept = default;
+  T& operator*() const noexcept { return *p_; }
+
+ private:
+  std::unique_ptr<T> p_;
 };
 }  // namespace chain_detail
 
@@ -165,6 +203,8 @@ class ChainSolver {
   int residual_markers_ = 0;
   int dof_ = 0;
   std::array<Mat3, kMaxBodies> cov_{};          // ball: 3x3 covariance of the increment
+  // gauss_newton()'s normal equations (~146 KiB: heap, allocated with the solver)
+  chain_detail::HeapValue<chain_detail::NormalEquations> normal_;
   chain_detail::LabelSearch search_;
   ChainCounters counters_;
 };

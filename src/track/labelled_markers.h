@@ -18,6 +18,8 @@
 
 namespace mocap {
 
+// Every marker of every body (32 x 16 = 512; a labelled marker is a distinct point, so
+// this also equals kMaxPoints). ~20 KiB: callers keep a LabelledMarkers off the stack.
 inline constexpr int kMaxLabelledMarkers = kMaxBodies * kMaxMarkers;
 
 struct LabelledMarker {

@@ -1,8 +1,9 @@
 // The replay backend on a small recording written by the test: every frame in order
 // with its number and timestamp, a missing file delivered as a missing frame (not a
 // stop), malformed files counted, end of stream, recorded timing honoured (a lower
-// bound: frames never come early), software trigger, buffer exhaustion, and no heap
-// allocation per frame.
+// bound: frames never come early), the recorded timestamp kept and the delivery stamped
+// (the latencies' origin), software trigger, buffer exhaustion, and no heap allocation
+// per frame.
 #include <gtest/gtest.h>
 
 #include <memory>
@@ -129,6 +130,27 @@ TEST_F(ReplayFixture, RecordedTimingNeverDeliversEarly) {
   } else {
     EXPECT_TRUE(s == CameraStatus::kTimeout || s == CameraStatus::kOk);  // the machine stalled
   }
+}
+
+// The recording's timestamps stay the data's (5 s + i x 20 ms here, long before this
+// process started); the latencies start at the delivery, on this host's clock.
+TEST_F(ReplayFixture, KeepsTheRecordedTimestampAndStampsTheDelivery) {
+  auto cam = camera(0, ReplayPacing::kAsFastAsPossible);
+  for (std::int64_t i = 0; i < 3; ++i) {
+    Frame f;
+    const std::int64_t before = monotonic_ns();
+    ASSERT_EQ(cam->dequeue(f, 100), CameraStatus::kOk);
+    const std::int64_t after = monotonic_ns();
+    EXPECT_EQ(f.timestamp_ns, 5'000'000'000 + i * kPeriodNs);
+    EXPECT_GE(f.delivered_ns, before);
+    EXPECT_LE(f.delivered_ns, after);
+    EXPECT_EQ(latency_origin_ns(f), f.delivered_ns);
+    ASSERT_EQ(cam->release(f), CameraStatus::kOk);
+  }
+  // A live camera's frame (delivered_ns 0): its timestamp is the local instant.
+  Frame live;
+  live.timestamp_ns = 123'456'789;
+  EXPECT_EQ(latency_origin_ns(live), 123'456'789);
 }
 
 TEST_F(ReplayFixture, SoftwareTriggerReleasesOneFrameEach) {

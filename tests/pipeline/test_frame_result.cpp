@@ -66,9 +66,10 @@ TEST(FrameResultBuilder, JointsPosesLabelledMarkersAndPoints) {
   out->angles.joints[1].type = JointType::kHinge;
 
   auto r = std::make_unique<publish::FrameResult>();
+  auto labelled = std::make_unique<LabelledMarkers>();
   {
     test::AllocationScope scope;
-    make_frame_result(7, 123456, targets, *out, *r);
+    make_frame_result(7, 123456, targets, *out, *labelled, *r);
     EXPECT_EQ(scope.count(), 0u);
   }
   EXPECT_EQ(r->joints.sequence, 7u);
@@ -153,9 +154,10 @@ TEST(FrameResultBuilder, BlobsSayWhatTheyBecame) {
   b0.point_index_of_marker[0] = 0;
 
   auto r = std::make_unique<publish::FrameResult>();
+  auto labelled = std::make_unique<LabelledMarkers>();
   {
     test::AllocationScope scope;
-    make_frame_result(1, 0, targets, *out, *r);
+    make_frame_result(1, 0, targets, *out, *labelled, *r);
     EXPECT_EQ(scope.count(), 0u);
   }
   using publish::BlobUse;

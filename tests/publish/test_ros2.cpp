@@ -6,8 +6,8 @@
 // positions equal to the datagram's float angles, invalid joints left out, one
 // transform per body found (parent "mocap", metres, x y z w), the stamp on
 // CLOCK_REALTIME. A reader that never takes does not slow publish() (drops counted).
-// DDS that cannot start gives one notice line and no sink (the tracker runs on).
-// Also: the pure mapping (names, ROS_DOMAIN_ID parsing, stamps).
+// DDS that cannot start gives one notice line and no sink (the tracker runs on). A
+// 32-body robot arrives whole. Also: the pure mapping (names, ROS_DOMAIN_ID parsing, stamps).
 #include <dds/dds.h>
 #include <gtest/gtest.h>
 #include <time.h>
@@ -320,6 +320,56 @@ TEST(Ros2Output, StalledReaderNeverStallsPublish) {
   EXPECT_EQ(c.published + c.dropped + c.failures, static_cast<std::uint64_t>(kFrames));
   EXPECT_GT(c.dropped, 0u);  // the worker could not keep up with an unpaced burst
   sink.reset();              // stops the worker and deletes the DDS entities promptly
+}
+
+// The whole robot (interfaces.md: models of up to 32 bodies, every output carries them
+// all): 32 bodies on /tf, the 31 ball joints' 93 DOFs on /joint_states.
+TEST(Ros2Output, ThirtyTwoBodiesReachTfAndJointStates) {
+  Fixture fx;
+  fx.targets.bodies.resize(3);
+  fx.model.joints.clear();
+  for (int b = 3; b < kMaxResultBodies; ++b) fx.targets.bodies.push_back(fx.targets.bodies[0]);
+  for (int b = 0; b < kMaxResultBodies; ++b) {
+    fx.targets.bodies[static_cast<std::size_t>(b)].name = "b" + std::to_string(b);
+    if (b == 0) continue;
+    JointSpec j;
+    j.name = "j" + std::to_string(b);
+    j.parent = "b" + std::to_string(b - 1);
+    j.child = "b" + std::to_string(b);
+    j.parent_index = b - 1;
+    j.child_index = b;
+    fx.model.joints.push_back(j);
+  }
+  const std::uint32_t domain = test_domain(2);
+  Reader reader(domain);
+  ASSERT_TRUE(reader.ok());
+  auto sink = make_sink(domain, fx);
+  ASSERT_NE(sink, nullptr);
+  ASSERT_TRUE(reader.wait_matched());
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  auto f = std::make_unique<FrameResult>();
+  f->joints.capture_ns = now_ns(CLOCK_MONOTONIC);
+  f->joints.joint_count = kMaxResultBodies - 1;
+  for (int j = 0; j < kMaxResultBodies - 1; ++j) f->joints.joints[j].valid = 1;
+  f->body_count = kMaxResultBodies;
+  for (int b = 0; b < kMaxResultBodies; ++b) f->bodies[static_cast<std::size_t>(b)].found = 1;
+  ASSERT_TRUE(sink->publish(*f));
+  std::vector<void*> js_loans, tf_loans;
+  std::vector<sensor_msgs_msg_dds__JointState_*> js;
+  std::vector<tf2_msgs_msg_dds__TFMessage_*> tf;
+  for (int i = 0; i < 300 && (js.empty() || tf.empty()); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    if (js.empty()) js = take_all<sensor_msgs_msg_dds__JointState_>(reader.js_, js_loans);
+    if (tf.empty()) tf = take_all<tf2_msgs_msg_dds__TFMessage_>(reader.tf_, tf_loans);
+  }
+  ASSERT_EQ(js.size(), 1u);
+  ASSERT_EQ(tf.size(), 1u);
+  EXPECT_EQ(js[0]->name._length, 3u * (kMaxResultBodies - 1));
+  EXPECT_STREQ(js[0]->name._buffer[js[0]->name._length - 1], "j31_z");
+  ASSERT_EQ(tf[0]->transforms._length, static_cast<std::uint32_t>(kMaxResultBodies));
+  EXPECT_STREQ(tf[0]->transforms._buffer[kMaxResultBodies - 1].child_frame_id, "b31");
+  dds_return_loan(reader.js_, js_loans.data(), static_cast<int32_t>(js_loans.size()));
+  dds_return_loan(reader.tf_, tf_loans.data(), static_cast<int32_t>(tf_loans.size()));
 }
 
 }  // namespace
