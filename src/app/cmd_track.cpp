@@ -20,6 +20,7 @@ namespace {
 struct TrackArgs {
   std::string recording, targets, model, out, stats, truth, config, c3d, trc;
   bool quiet = false;
+  int threads = 2;
 };
 
 int run_track(const TrackArgs& a) {
@@ -32,6 +33,7 @@ int run_track(const TrackArgs& a) {
   opt.truth_dir = a.truth;
   opt.c3d_path = a.c3d;
   opt.trc_path = a.trc;
+  opt.detect_threads = a.threads;
   if (!a.config.empty()) {
     auto cfg = config::load_run_config(a.config);
     if (!cfg) return fail(cfg.error().message);
@@ -79,6 +81,10 @@ void register_track(CLI::App& app, int& exit_code) {
       "--config", args->config,
       "Take the detection/stereo/identification thresholds from this run configuration (YAML)");
   cmd->add_flag("--quiet", args->quiet, "Print nothing but errors and warnings");
+  cmd->add_option("--threads", args->threads,
+                  "Detection threads, 1 or 2 (default 2: the cameras of a frame are detected "
+                  "on two cores, as live; the outputs are identical)")
+      ->check(CLI::Range(1, 2));
   cmd->callback([args, &exit_code] { exit_code = run_track(*args); });
 }
 

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <utility>
 
 #include "stereo/nview.h"
 
@@ -25,10 +26,22 @@ Expected<MultiViewMerger> MultiViewMerger::create(const Rig& rig, const MultiVie
     return Error{"multiview: marker_radius_mm must be >= 0"};
   if (config.max_points_per_camera < 1 || config.max_hypotheses < 1)
     return Error{"multiview: max_points_per_camera and max_hypotheses must be positive"};
-  return MultiViewMerger(rig, config);
+  if (!(config.grid_cell_px > 0.0) || !std::isfinite(config.grid_cell_px))
+    return Error{"multiview: grid_cell_px must be a positive number"};
+  std::vector<BlobGrid> grids;
+  for (const CameraModel& cam : rig.cameras) {
+    auto grid = BlobGrid::create(std::max(cam.width, 0), std::max(cam.height, 0),
+                                 config.grid_cell_px, config.max_points_per_camera);
+    if (!grid) return Error{"multiview: " + cam.name + ": " + grid.error().message};
+    grids.push_back(std::move(grid).value());
+  }
+  auto same_index = BlobSetIndex::create(config.max_hypotheses);
+  if (!same_index) return Error{"multiview: " + same_index.error().message};
+  return MultiViewMerger(rig, config, std::move(grids), std::move(same_index).value());
 }
 
-MultiViewMerger::MultiViewMerger(const Rig& rig, const MultiViewConfig& config)
+MultiViewMerger::MultiViewMerger(const Rig& rig, const MultiViewConfig& config,
+                                 std::vector<BlobGrid> grids, BlobSetIndex same_index)
     : cams_(rig.cameras),
       config_(config),
       hyp_(static_cast<std::size_t>(config.max_hypotheses)),
@@ -37,7 +50,9 @@ MultiViewMerger::MultiViewMerger(const Rig& rig, const MultiViewConfig& config)
       extended_(static_cast<std::size_t>(config.max_hypotheses)),
       out_hyp_(static_cast<std::size_t>(config.max_hypotheses)),
       order_(static_cast<std::size_t>(config.max_hypotheses)),
-      taken_by_(rig.cameras.size() * static_cast<std::size_t>(config.max_points_per_camera)) {}
+      taken_by_(rig.cameras.size() * static_cast<std::size_t>(config.max_points_per_camera)),
+      grids_(std::move(grids)),
+      same_index_(std::move(same_index)) {}
 
 double MultiViewMerger::unfit_gate_px(int c, const Vec3& X_world) const noexcept {
   const CameraModel& cam = cams_[static_cast<std::size_t>(c)];
@@ -49,25 +64,20 @@ double MultiViewMerger::unfit_gate_px(int c, const Vec3& X_world) const noexcept
 // Adds every camera not yet used whose nearest blob lies within the gate of the
 // projection (the nearest one only: two blobs within 2 px are one marker's split); a
 // nearest blob beyond the gate but within the unfit gate is counted as an unfit view.
-void MultiViewMerger::extend(int i, const Vec2* const* px, const int* n) noexcept {
+// The blobs are those of grids_[c] (the first max_points_per_camera of camera c).
+void MultiViewMerger::extend(int i) noexcept {
   Point3& h = hyp_[static_cast<std::size_t>(i)];
   int& partial = partial_views_[static_cast<std::size_t>(i)];
   partial = 0;
+  const bool indexed = config_.search == MergeSearch::kIndexed;
   for (int c = 0; c < camera_count(); ++c) {
-    if (h.blob_index[c] >= 0) continue;
+    const BlobGrid& grid = grids_[static_cast<std::size_t>(c)];
+    if (h.blob_index[c] >= 0 || grid.size() == 0) continue;  // no blob: nothing to find
     Vec2 q;
     if (!project(cams_[static_cast<std::size_t>(c)], h.X_world, q)) continue;  // behind
-    const int m = std::min(n[c], config_.max_points_per_camera);
     const double wide = std::max(config_.gate_px, unfit_gate_px(c, h.X_world));
-    int best = -1;
-    double best_d2 = wide * wide;
-    for (int j = 0; j < m; ++j) {
-      const double d2 = (px[c][j] - q).squaredNorm();
-      if (d2 <= best_d2) {
-        best_d2 = d2;
-        best = j;
-      }
-    }
+    double best_d2 = 0.0;
+    const int best = indexed ? grid.nearest(q, wide, best_d2) : grid.nearest_scan(q, wide, best_d2);
     if (best < 0) continue;
     if (best_d2 <= config_.gate_px * config_.gate_px) {
       h.blob_index[c] = static_cast<std::int16_t>(best);
@@ -120,6 +130,17 @@ void MultiViewMerger::refine(int i, const Vec2* const* px) noexcept {
     h.blob_index[c] = -1;
     ++counters_.views_dropped;
   }
+}
+
+int MultiViewMerger::same_as_earlier(int i) noexcept {
+  const BlobRefs& key = extended_[static_cast<std::size_t>(i)];
+  if (config_.search == MergeSearch::kIndexed) {
+    const int same = same_index_.find_or_insert(extended_.data(), i);
+    if (same != BlobSetIndex::kFull) return same;  // cannot fill: one entry per hypothesis
+  }
+  for (int k = 0; k < i; ++k)
+    if (extended_[static_cast<std::size_t>(k)] == key) return k;
+  return -1;
 }
 
 bool MultiViewMerger::is_unfit_pairing(int i, const Point3& o,
@@ -210,6 +231,10 @@ bool MultiViewMerger::process(const Vec2* const* px, const int* n, const PointLi
     }
     return complete;
   }
+  for (int c = 0; c < camera_count(); ++c) {
+    const int m = grids_[static_cast<std::size_t>(c)].build(px[c], n[c]);
+    if (n[c] > m) counters_.blob_overflow += static_cast<std::uint64_t>(n[c] - m);
+  }
   int count = 0;
   for (int p = 0; p < pair_count; ++p) {
     for (const Point3& c : *pairs[p]) {
@@ -222,13 +247,13 @@ bool MultiViewMerger::process(const Vec2* const* px, const int* n, const PointLi
       hyp_[static_cast<std::size_t>(count++)] = c;
     }
   }
+  same_index_.clear(count);
   for (int i = 0; i < count; ++i) {
     Point3& h = hyp_[static_cast<std::size_t>(i)];
-    extend(i, px, n);
+    extend(i);
     extended_[static_cast<std::size_t>(i)] = h.blob_index;
-    int same = -1;  // the same point from another pair: the same blobs once extended
-    for (int k = 0; k < i && same < 0; ++k)
-      if (extended_[static_cast<std::size_t>(k)] == h.blob_index) same = k;
+    // The same point from another pair: the same blobs once extended.
+    const int same = same_as_earlier(i);
     if (same >= 0) {
       h = hyp_[static_cast<std::size_t>(same)];  // refined already
       partial_views_[static_cast<std::size_t>(i)] = partial_views_[static_cast<std::size_t>(same)];
@@ -236,24 +261,22 @@ bool MultiViewMerger::process(const Vec2* const* px, const int* n, const PointLi
       refine(i, px);
     }
     views_[static_cast<std::size_t>(i)] = h.blob_index.count();
-    order_[static_cast<std::size_t>(i)] = i;
+    order_[static_cast<std::size_t>(i)] =
+        AcceptKey{views_[static_cast<std::size_t>(i)], partial_views_[static_cast<std::size_t>(i)],
+                  h.reproj_px, i};
   }
-  std::sort(order_.begin(), order_.begin() + count, [&](int a, int b) {
-    const int va = views_[static_cast<std::size_t>(a)], vb = views_[static_cast<std::size_t>(b)];
-    if (va != vb) return va > vb;
+  // The keys sit side by side (not looked up in hyp_): the sort touches one small array.
+  std::sort(order_.begin(), order_.begin() + count, [](const AcceptKey& a, const AcceptKey& b) {
+    if (a.views != b.views) return a.views > b.views;
     // Then the cameras that see part of the ball there: a ghost (two blobs of different
     // markers on one epipolar line) has no image at all in the other cameras.
-    const int pa = partial_views_[static_cast<std::size_t>(a)];
-    const int pb = partial_views_[static_cast<std::size_t>(b)];
-    if (pa != pb) return pa > pb;
-    const double ra = hyp_[static_cast<std::size_t>(a)].reproj_px;
-    const double rb = hyp_[static_cast<std::size_t>(b)].reproj_px;
-    return ra != rb ? ra < rb : a < b;
+    if (a.partial != b.partial) return a.partial > b.partial;
+    return a.reproj_px != b.reproj_px ? a.reproj_px < b.reproj_px : a.index < b.index;
   });
   const std::size_t per_cam = static_cast<std::size_t>(config_.max_points_per_camera);
   std::fill(taken_by_.begin(), taken_by_.end(), -1);
   for (int r = 0; r < count; ++r) {
-    const int i = order_[static_cast<std::size_t>(r)];
+    const int i = order_[static_cast<std::size_t>(r)].index;
     Point3 h = hyp_[static_cast<std::size_t>(i)];
     const int views = views_[static_cast<std::size_t>(i)];
     // The taken points using one of h's blobs (at most one per camera).

@@ -31,6 +31,13 @@
 // consistent pair of stray blobs is a point like any other for the identification,
 // which rejects what fits no target. With two cameras there is nothing to add: the
 // pair's candidates pass unchanged.
+// Cost: linear in the blobs and hypotheses. The blobs of every camera are put in a
+// uniform grid per frame (blob_grid.h), so the third-view lookup visits only the cells
+// around the projection; the duplicate lookup (the first earlier hypothesis with the
+// same blob set) is a hash table (blob_set_index.h); the acceptance takes the owners of
+// a hypothesis's blobs from a blob -> point table. MergeSearch::kExhaustive runs the
+// same steps by linear scans (every blob, every earlier hypothesis): the reference, with
+// an identical result (tests/stereo/test_stereo_index.cpp).
 // Capacity is fixed in create(); process() is noexcept and allocation-free; overflows
 // and rejections are counters. Each output point records its blob per camera.
 #pragma once
@@ -41,9 +48,15 @@
 
 #include "camera/camera_model.h"
 #include "core/expected.h"
+#include "stereo/blob_grid.h"
+#include "stereo/blob_set_index.h"
 #include "stereo/stereo_types.h"
 
 namespace mocap {
+
+// How the merge finds blobs near a projection and earlier hypotheses with the same blobs:
+// spatial index and hash (default), or linear scans (the reference; same result).
+enum class MergeSearch : std::uint8_t { kIndexed, kExhaustive };
 
 struct MultiViewConfig {
   // A further view supports a point when one of its blobs lies within this distance of
@@ -56,6 +69,10 @@ struct MultiViewConfig {
   // Radius of the marker balls (mm; the targets' marker_diameter / 2): bounds how far a
   // partly hidden ball's centroid can move. 0: only blobs within gate_px count.
   double marker_radius_mm = 0.0;
+  MergeSearch search = MergeSearch::kIndexed;
+  // Cell of the per-camera blob grid (px): a few times the lookup radius (the gate plus
+  // a ball's image radius), so a lookup visits one to four cells.
+  double grid_cell_px = 64.0;
 };
 
 struct MultiViewCounters {
@@ -72,6 +89,7 @@ struct MultiViewCounters {
   std::uint64_t ambiguous = 0;            // emitted points flagged ambiguous
   std::uint64_t points = 0;               // emitted points
   std::uint64_t point_overflow = 0;       // emitted points beyond the output's capacity
+  std::uint64_t blob_overflow = 0;        // blobs beyond max_points_per_camera (ignored)
 };
 
 class MultiViewMerger {
@@ -97,8 +115,11 @@ class MultiViewMerger {
   const MultiViewCounters& counters() const noexcept { return counters_; }
 
  private:
-  MultiViewMerger(const Rig& rig, const MultiViewConfig& config);
-  void extend(int i, const Vec2* const* px, const int* n) noexcept;
+  MultiViewMerger(const Rig& rig, const MultiViewConfig& config, std::vector<BlobGrid> grids,
+                  BlobSetIndex same_index);
+  // The first earlier hypothesis (< i) with the blob set extended_[i], or -1.
+  int same_as_earlier(int i) noexcept;
+  void extend(int i) noexcept;
   void refine(int i, const Vec2* const* px) noexcept;
   // gate_px plus the marker's image radius in camera c at X_world (0: behind).
   double unfit_gate_px(int c, const Vec3& X_world) const noexcept;
@@ -118,8 +139,16 @@ class MultiViewMerger {
   std::vector<int> partial_views_;  // per hypothesis: cameras with only an unfit view
   std::vector<BlobRefs> extended_;  // blobs before refinement
   std::vector<int> out_hyp_;        // per output point: the hypothesis it came from
-  std::vector<int> order_;          // hypotheses in acceptance order
-  std::vector<int> taken_by_;       // [camera * max_points_per_camera + blob]: output index
+  struct AcceptKey {  // acceptance order: more views, more partly seen, smaller RMS, index
+    int views;
+    int partial;
+    double reproj_px;
+    int index;
+  };
+  std::vector<AcceptKey> order_;  // hypotheses in acceptance order
+  std::vector<int> taken_by_;     // [camera * max_points_per_camera + blob]: output index
+  std::vector<BlobGrid> grids_;   // per camera: this frame's blobs by image cell
+  BlobSetIndex same_index_;       // this frame's extended blob sets -> first hypothesis
   MultiViewCounters counters_;
 };
 

@@ -13,6 +13,7 @@
 #include <cmath>
 #include <numbers>
 #include <string>
+#include <utility>
 
 namespace mocap {
 namespace {
@@ -61,6 +62,12 @@ Expected<StereoTriangulator> StereoTriangulator::create(const Rig& rig, const St
   if (std::abs(bdir.x()) > 0.9) seed = Vec3::UnitY();
   t.plane_u_0_ = bdir.cross(seed).normalized();
   t.plane_v_0_ = bdir.cross(t.plane_u_0_);
+  auto ua = BlobUndistorter::create(ca, c.max_points_per_camera);
+  auto ub = BlobUndistorter::create(cb, c.max_points_per_camera);
+  if (!ua) return ua.error();
+  if (!ub) return ub.error();
+  t.undistort_a_ = std::move(ua).value();
+  t.undistort_b_ = std::move(ub).value();
   const auto cap = static_cast<std::size_t>(c.max_points_per_camera);
   t.obs_a_.resize(cap);
   t.obs_b_.resize(cap);
@@ -70,21 +77,21 @@ Expected<StereoTriangulator> StereoTriangulator::create(const Rig& rig, const St
   return t;
 }
 
-void StereoTriangulator::prepare(const Vec2* px, int n, int camera,
+void StereoTriangulator::prepare(const UndistortedBlobs& blobs, int n, int camera,
                                  std::vector<Observation>& obs) noexcept {
   const CameraModel& cam = camera == 0 ? cam_a_model_ : cam_b_model_;
   const double f_min = std::min(cam.fx, cam.fy);
   for (int i = 0; i < n; ++i) {
     Observation& o = obs[static_cast<std::size_t>(i)];
-    o.px = px[i];
+    o.px = blobs.px[i];
     o.valid = false;
     o.theta = 0.0;
     o.window = kPi;
-    Vec2 xn;
-    if (!finite(o.px.x()) || !finite(o.px.y()) || !undistort_pixel(cam, o.px, xn)) {
+    if (blobs.valid[i] == 0) {  // not finite, or the undistortion failed
       ++counters_.undistort_failed[static_cast<std::size_t>(camera)];
       continue;
     }
+    const Vec2& xn = blobs.xn[i];
     o.valid = true;
     o.s = to_scaled(cam, xn);
     // Unit ray in camera-a coordinates.
@@ -93,11 +100,12 @@ void StereoTriangulator::prepare(const Vec2* px, int n, int camera,
     r.normalize();
     const double p = r.dot(plane_u_0_);
     const double q = r.dot(plane_v_0_);
-    const double rho = std::hypot(p, q);
     double theta = std::atan2(q, p);
     if (theta < 0.0) theta += kPi;
     if (theta >= kPi) theta -= kPi;
     o.theta = theta;
+    if (camera == 1) continue;  // camera b's blobs are only searched: no window
+    const double rho = std::hypot(p, q);
     // Safety margin for rounding: the window only has to be conservative.
     const double s = config_.epipolar_tolerance_px * (1.0 + 1e-9) / (f_min * rho) + 1e-12;
     o.window = s >= 1.0 || !finite(s) ? kPi : std::asin(s) + 1e-12;
@@ -171,30 +179,41 @@ void StereoTriangulator::scan_range(int i, double lo, double hi, PointList& out,
 
 bool StereoTriangulator::process(const Vec2* px_a, int n_a, const Vec2* px_b, int n_b,
                                  PointList& out) noexcept {
+  const bool bad =
+      n_a < 0 || n_b < 0 || (n_a > 0 && px_a == nullptr) || (n_b > 0 && px_b == nullptr);
+  // Bad input undistorts nothing; the view form counts it.
+  return process(bad ? UndistortedBlobs{px_a, n_a} : undistort_a_.undistort(px_a, n_a),
+                 bad ? UndistortedBlobs{px_b, n_b} : undistort_b_.undistort(px_b, n_b), out);
+}
+
+bool StereoTriangulator::process(const UndistortedBlobs& a, const UndistortedBlobs& b,
+                                 PointList& out) noexcept {
   out.clear();
   ++counters_.frames;
   frame_overflow_ = false;
-  if (n_a < 0 || n_b < 0 || (n_a > 0 && px_a == nullptr) || (n_b > 0 && px_b == nullptr)) {
+  const int r_a = a.received, r_b = b.received;
+  if (r_a < 0 || r_b < 0 || (r_a > 0 && a.px == nullptr) || (r_b > 0 && b.px == nullptr)) {
     ++counters_.bad_input;
     return false;
   }
-  counters_.points_in[0] += static_cast<std::uint64_t>(n_a);
-  counters_.points_in[1] += static_cast<std::uint64_t>(n_b);
+  counters_.points_in[0] += static_cast<std::uint64_t>(r_a);
+  counters_.points_in[1] += static_cast<std::uint64_t>(r_b);
   const int cap = config_.max_points_per_camera;
-  if (n_a > cap) {
-    counters_.points_overflow[0] += static_cast<std::uint64_t>(n_a - cap);
-    n_a = cap;
+  // Blobs beyond this pair's capacity, or not undistorted by the view's, are ignored.
+  const int n_a = std::min({r_a, cap, a.count});
+  const int n_b = std::min({r_b, cap, b.count});
+  if (n_a < r_a) {
+    counters_.points_overflow[0] += static_cast<std::uint64_t>(r_a - n_a);
     frame_overflow_ = true;
   }
-  if (n_b > cap) {
-    counters_.points_overflow[1] += static_cast<std::uint64_t>(n_b - cap);
-    n_b = cap;
+  if (n_b < r_b) {
+    counters_.points_overflow[1] += static_cast<std::uint64_t>(r_b - n_b);
     frame_overflow_ = true;
   }
   n_a_ = n_a;
   n_b_ = n_b;
-  prepare(px_a, n_a, 0, obs_a_);
-  prepare(px_b, n_b, 1, obs_b_);
+  prepare(a, n_a, 0, obs_a_);
+  prepare(b, n_b, 1, obs_b_);
   std::fill_n(use_a_.begin(), n_a, std::uint16_t{0});
   std::fill_n(use_b_.begin(), n_b, std::uint16_t{0});
   const int capacity = std::min(out.capacity(), config_.max_candidates);

@@ -18,6 +18,9 @@
 // Capacity is fixed in create(); process() is noexcept and allocation-free. Failures
 // and overflows become counters. For N cameras, run one triangulator per camera pair
 // (pairs enumerated by the caller); blob_index is indexed by the rig's camera index.
+// With N cameras, undistort each camera's blobs once per frame (BlobUndistorter,
+// undistorted_blobs.h) and pass the views: the same result without undistorting every
+// camera N - 1 times.
 #pragma once
 
 #include <array>
@@ -28,6 +31,7 @@
 #include "core/expected.h"
 #include "stereo/stereo_types.h"
 #include "stereo/two_view.h"
+#include "stereo/undistorted_blobs.h"
 
 namespace mocap {
 
@@ -94,6 +98,10 @@ class StereoTriangulator {
   // max_candidates)). Returns false when something was dropped this frame (blob or
   // candidate overflow, bad input); the candidates written are valid either way.
   bool process(const Vec2* px_a, int n_a, const Vec2* px_b, int n_b, PointList& out) noexcept;
+  // The same from blobs undistorted once per camera and frame: `a` of camera_a(), `b` of
+  // camera_b() (views of a BlobUndistorter of that rig camera with a capacity of at least
+  // max_points_per_camera). Identical result and counters.
+  bool process(const UndistortedBlobs& a, const UndistortedBlobs& b, PointList& out) noexcept;
 
   const StereoCounters& counters() const noexcept { return counters_; }
   void reset_counters() noexcept { counters_ = StereoCounters{}; }
@@ -116,7 +124,8 @@ class StereoTriangulator {
   };
 
   StereoTriangulator() = default;
-  void prepare(const Vec2* px, int n, int camera, std::vector<Observation>& obs) noexcept;
+  void prepare(const UndistortedBlobs& blobs, int n, int camera,
+               std::vector<Observation>& obs) noexcept;
   void try_pair(int i, int j, PointList& out, int capacity) noexcept;
   void scan_range(int i, double lo, double hi, PointList& out, int capacity) noexcept;
 
@@ -128,6 +137,8 @@ class StereoTriangulator {
   Vec3 plane_v_0_ = Vec3::Zero();
   int cam_a_ = 0;
   int cam_b_ = 1;
+  BlobUndistorter undistort_a_;  // for process() from distorted pixels
+  BlobUndistorter undistort_b_;
   std::vector<Observation> obs_a_;
   std::vector<Observation> obs_b_;
   std::vector<SortKey> keys_b_;

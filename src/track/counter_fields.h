@@ -98,7 +98,7 @@ inline constexpr std::array<CounterField<StereoCounters>, 14> kStereoFields = {{
 }};
 
 // Reported as multiview_<name>, with three or more cameras.
-inline constexpr std::array<CounterField<MultiViewCounters>, 13> kMultiViewFields = {{
+inline constexpr std::array<CounterField<MultiViewCounters>, 14> kMultiViewFields = {{
     MOCAP_COUNTER_FIELD(MultiViewCounters, frames),
     MOCAP_COUNTER_FIELD(MultiViewCounters, hypotheses),
     MOCAP_COUNTER_FIELD(MultiViewCounters, hypothesis_overflow),
@@ -112,6 +112,7 @@ inline constexpr std::array<CounterField<MultiViewCounters>, 13> kMultiViewField
     MOCAP_COUNTER_FIELD(MultiViewCounters, ambiguous),
     MOCAP_COUNTER_FIELD(MultiViewCounters, points),
     MOCAP_COUNTER_FIELD(MultiViewCounters, point_overflow),
+    MOCAP_COUNTER_FIELD(MultiViewCounters, blob_overflow),
 }};
 
 // Reported as identify_<name>.

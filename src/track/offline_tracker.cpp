@@ -10,6 +10,7 @@
 #include "formats/joints_yaml.h"
 #include "formats/recording.h"
 #include "formats/targets_yaml.h"
+#include "track/detect_workers.h"
 #include "track/labelled_markers.h"
 #include "track/trajectory_export.h"
 
@@ -73,6 +74,9 @@ Expected<OfflineTrackResult> track_recording(const OfflineTrackOptions& opt) {
   }
 
   FrameOutput out = proc->make_output();
+  // Detection on the two cores, as live (detect_workers.h); one camera needs no worker.
+  std::optional<ParallelDetect> parallel;
+  if (opt.detect_threads >= 2 && proc->camera_count() >= 2) parallel.emplace(*proc);
   FrameSetLoader loader(*rec);
   PointRow point_row;
   PoseRow pose_row;
@@ -87,7 +91,11 @@ Expected<OfflineTrackResult> track_recording(const OfflineTrackOptions& opt) {
     result.frames_missing += missing ? 1 : 0;
     result.frames_damaged += damaged ? 1 : 0;
 
-    proc->process(loader.views(), fe.timestamp_ns, out);
+    if (parallel) {
+      parallel->process(loader.views(), fe.timestamp_ns, out);
+    } else {
+      proc->process(loader.views(), fe.timestamp_ns, out);
+    }
     result.stats->record(out.times);
     ++result.stats->frames;
     ++result.frames;

@@ -30,6 +30,7 @@ struct OfflineTrackOptions {
   std::string trc_path;    // empty: no TRC export
   std::string truth_dir;   // empty: no accuracy report (simulator ground truth, e.g. REC/gt)
   TrackerConfig config{};
+  int detect_threads = 2;  // 1: every camera on the calling thread; 2: ParallelDetect
   std::function<void(std::int64_t done, std::int64_t total)> progress;
   std::function<void(const std::string& message)> warn;  // one line per problem
 };

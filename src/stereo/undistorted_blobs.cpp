@@ -1,0 +1,36 @@
+// Design: see undistorted_blobs.h.
+#include "stereo/undistorted_blobs.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace mocap {
+
+Expected<BlobUndistorter> BlobUndistorter::create(const CameraModel& camera, int max_points) {
+  if (max_points < 1 || max_points > 32767)
+    return make_error("stereo", "max_points_per_camera", "must be in [1, 32767]");
+  BlobUndistorter u;
+  u.camera_ = camera;
+  u.xn_.assign(static_cast<std::size_t>(max_points), Vec2::Zero());
+  u.valid_.assign(static_cast<std::size_t>(max_points), 0);
+  return u;
+}
+
+UndistortedBlobs BlobUndistorter::undistort(const Vec2* px, int n) noexcept {
+  UndistortedBlobs v;
+  v.px = px;
+  v.received = n;
+  v.xn = xn_.data();
+  v.valid = valid_.data();
+  if (px == nullptr || n <= 0) return v;
+  v.count = std::min(n, capacity());
+  for (int i = 0; i < v.count; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    const Vec2& p = px[i];
+    valid_[k] =
+        std::isfinite(p.x()) && std::isfinite(p.y()) && undistort_pixel(camera_, p, xn_[k]) ? 1 : 0;
+  }
+  return v;
+}
+
+}  // namespace mocap
