@@ -283,8 +283,9 @@ void read_identification(const YAML::Node& node, IdentifyConfig& c) {
       node, "identification",
       {"t_mm", "min_markers", "best_pairs", "ambiguity_ratio", "residual_floor_mm",
        "max_search_nodes", "temporal", "warm_gate_mm", "warm_min_markers", "max_prior_age_s",
-       "max_speed_mm_per_s", "max_angular_speed_deg_per_s", "point_sigma_mm", "partial_sigma_mm",
-       "consistency_confidence", "exclude_partial_markers", "min_whole_markers", "max_points"});
+       "max_speed_mm_per_s", "max_angular_speed_deg_per_s", "max_acceleration_mm_per_s2",
+       "point_sigma_mm", "partial_sigma_mm", "consistency_confidence", "exclude_partial_markers",
+       "min_whole_markers", "max_points"});
   set(c.t_mm, positive(s, "t_mm", 1000.0));
   set(c.min_markers, s.integer("min_markers", 3, 64));
   set(c.best_pairs, s.integer("best_pairs", 1, 100000));
@@ -297,6 +298,8 @@ void read_identification(const YAML::Node& node, IdentifyConfig& c) {
   set(c.max_prior_age_s, s.number("max_prior_age_s", 0.0, 60.0));
   set(c.max_speed_mm_per_s, s.number("max_speed_mm_per_s", 0.0, 1e6));
   set(c.max_angular_speed_deg_per_s, s.number("max_angular_speed_deg_per_s", 0.0, 1e6));
+  // 0: max_speed x max_angular_speed (identify/motion.h derives the gates from it).
+  set(c.max_acceleration_mm_per_s2, s.number("max_acceleration_mm_per_s2", 0.0, 1e9));
   set(c.point_sigma_mm, s.number("point_sigma_mm", 0.0, 100.0));
   set(c.partial_sigma_mm, s.number("partial_sigma_mm", 0.0, 100.0));
   set(c.consistency_confidence, s.number("consistency_confidence", 0.99, 0.999999));

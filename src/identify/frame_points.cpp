@@ -1,22 +1,141 @@
-// Design: see frame_points.h. The pair list is built in O(n^2) and sorted in place
-// (std::sort allocates nothing); blob occupancy uses a counter per possible int16 blob
-// index so that acquire/release are O(1) and exactly undo each other.
+// Design: see frame_points.h. The pairs come from the grid (each point against the
+// points of its 27 neighbouring cells with a larger index, every bucket visited once) and
+// are sorted in place (std::sort allocates nothing); the neighbour lists are a CSR array
+// filled from the pairs, each list sorted by index (insertion sort: lists are short).
+// Blob occupancy uses a counter per possible int16 blob index so that acquire/release are
+// O(1) and exactly undo each other.
 #include "identify/frame_points.h"
 
 #include <algorithm>
 #include <cmath>
 
 namespace mocap {
+namespace {
+constexpr double kMaxCellIndex = 1e12;  // clamp of the cell coordinates (no overflow)
+
+std::uint32_t bucket_count_for(int max_points) {
+  std::uint32_t b = 16;
+  while (b < 2u * static_cast<std::uint32_t>(max_points)) b *= 2;
+  return b;
+}
+
+// Distinct buckets of the cells lo..hi (inclusive, per axis); false if more than 27 cells.
+template <typename BucketOf>
+int collect_buckets(const std::array<std::int64_t, 3>& lo, const std::array<std::int64_t, 3>& hi,
+                    BucketOf bucket_of, std::array<std::uint32_t, 27>& out) {
+  int n = 0;
+  for (std::int64_t x = lo[0]; x <= hi[0]; ++x)
+    for (std::int64_t y = lo[1]; y <= hi[1]; ++y)
+      for (std::int64_t z = lo[2]; z <= hi[2]; ++z) {
+        const std::uint32_t b = bucket_of(std::array<std::int64_t, 3>{x, y, z});
+        bool seen = false;
+        for (int s = 0; s < n && !seen; ++s) seen = out[static_cast<std::size_t>(s)] == b;
+        if (!seen) out[static_cast<std::size_t>(n++)] = b;
+      }
+  return n;
+}
+}  // namespace
 
 FramePoints::FramePoints(int max_points)
     : capacity_(max_points),
+      bucket_mask_(bucket_count_for(max_points) - 1),
       X_(static_cast<std::size_t>(max_points)),
       blob_(static_cast<std::size_t>(max_points)),
       valid_(static_cast<std::size_t>(max_points), 0),
       partial_(static_cast<std::size_t>(max_points), 0),
       point_uses_(static_cast<std::size_t>(max_points), 0),
-      pairs_(static_cast<std::size_t>(max_points) * static_cast<std::size_t>(max_points - 1) / 2) {
+      pairs_(static_cast<std::size_t>(max_points) * static_cast<std::size_t>(max_points - 1) / 2),
+      bucket_start_(bucket_count_for(max_points) + 1, 0),
+      bucket_points_(static_cast<std::size_t>(max_points), 0),
+      bucket_of_point_(static_cast<std::size_t>(max_points), 0),
+      adj_start_(static_cast<std::size_t>(max_points) + 1, 0),
+      adj_(pairs_.size() * 2, 0) {
   for (auto& uses : blob_uses_) uses.assign(kBlobSlots, 0);
+}
+
+std::array<std::int64_t, 3> FramePoints::cell_of(const Vec3& x) const noexcept {
+  std::array<std::int64_t, 3> c{};
+  for (int a = 0; a < 3; ++a)
+    c[static_cast<std::size_t>(a)] = static_cast<std::int64_t>(
+        std::floor(std::clamp(x[a] / cell_mm_, -kMaxCellIndex, kMaxCellIndex)));
+  return c;
+}
+
+std::uint32_t FramePoints::bucket_of(const std::array<std::int64_t, 3>& c) const noexcept {
+  const auto h = static_cast<std::uint64_t>(c[0]) * 73856093u ^
+                 static_cast<std::uint64_t>(c[1]) * 19349663u ^
+                 static_cast<std::uint64_t>(c[2]) * 83492791u;
+  return static_cast<std::uint32_t>(h ^ (h >> 29)) & bucket_mask_;
+}
+
+void FramePoints::build_grid() noexcept {
+  std::fill(bucket_start_.begin(), bucket_start_.end(), 0);
+  for (int i = 0; i < n_; ++i) {
+    const auto s = static_cast<std::size_t>(i);
+    if (!valid_[s]) continue;
+    bucket_of_point_[s] = bucket_of(cell_of(X_[s]));
+    ++bucket_start_[bucket_of_point_[s] + 1];
+  }
+  for (std::size_t b = 1; b < bucket_start_.size(); ++b) bucket_start_[b] += bucket_start_[b - 1];
+  // Fill (ascending point index within a bucket), then restore the starts.
+  for (int i = 0; i < n_; ++i) {
+    const auto s = static_cast<std::size_t>(i);
+    if (valid_[s])
+      bucket_points_[static_cast<std::size_t>(bucket_start_[bucket_of_point_[s]]++)] =
+          static_cast<std::int16_t>(i);
+  }
+  for (std::size_t b = bucket_start_.size() - 1; b > 0; --b)
+    bucket_start_[b] = bucket_start_[b - 1];
+  bucket_start_[0] = 0;
+}
+
+void FramePoints::build_pairs(double max2) noexcept {
+  int c = 0;
+  std::fill(adj_start_.begin(), adj_start_.begin() + n_ + 1, 0);
+  std::array<std::uint32_t, 27> buckets{};
+  for (int i = 0; i < n_; ++i) {
+    if (!valid_[static_cast<std::size_t>(i)]) continue;
+    auto lo = cell_of(X(i)), hi = lo;
+    for (std::size_t a = 0; a < 3; ++a) {
+      --lo[a];
+      ++hi[a];
+    }
+    const int nbk = collect_buckets(
+        lo, hi, [this](const auto& cell) { return bucket_of(cell); }, buckets);
+    for (int q = 0; q < nbk; ++q) {
+      const std::uint32_t b = buckets[static_cast<std::size_t>(q)];
+      for (int e = bucket_start_[b]; e < bucket_start_[b + 1]; ++e) {
+        const int j = bucket_points_[static_cast<std::size_t>(e)];
+        if (j <= i || exclusive(i, j)) continue;
+        const double d2 = (X(i) - X(j)).squaredNorm();
+        if (d2 > max2) continue;
+        pairs_[static_cast<std::size_t>(c++)] =
+            PointPair{std::sqrt(d2), static_cast<std::int16_t>(i), static_cast<std::int16_t>(j)};
+        ++adj_start_[static_cast<std::size_t>(i) + 1];
+        ++adj_start_[static_cast<std::size_t>(j) + 1];
+      }
+    }
+  }
+  pair_count_ = c;
+  for (int i = 0; i < n_; ++i)
+    adj_start_[static_cast<std::size_t>(i) + 1] += adj_start_[static_cast<std::size_t>(i)];
+  // Fill with a moving cursor per point (adj_start_[i + 1] temporarily), then sort.
+  for (int p = 0; p < c; ++p) {
+    const PointPair& pp = pairs_[static_cast<std::size_t>(p)];
+    adj_[static_cast<std::size_t>(adj_start_[static_cast<std::size_t>(pp.i)]++)] = pp.j;
+    adj_[static_cast<std::size_t>(adj_start_[static_cast<std::size_t>(pp.j)]++)] = pp.i;
+  }
+  for (int i = n_; i > 0; --i)
+    adj_start_[static_cast<std::size_t>(i)] = adj_start_[static_cast<std::size_t>(i) - 1];
+  adj_start_[0] = 0;
+  for (int i = 0; i < n_; ++i) {
+    std::int16_t* a = adj_.data() + adj_start_[static_cast<std::size_t>(i)];
+    const int na = neighbour_count(i);
+    for (int x = 1; x < na; ++x)  // insertion sort: ascending index
+      for (int y = x; y > 0 && a[y - 1] > a[y]; --y) std::swap(a[y - 1], a[y]);
+  }
+  std::sort(pairs_.begin(), pairs_.begin() + c,
+            [](const PointPair& a, const PointPair& b) { return a.d_mm < b.d_mm; });
 }
 
 FramePoints::LoadStats FramePoints::load(const MeasuredPoint* pts, int n,
@@ -38,22 +157,49 @@ FramePoints::LoadStats FramePoints::load(const MeasuredPoint* pts, int n,
     if (!valid_[s]) ++stats.invalid;
     point_uses_[s] = 0;
   }
-  const double max2 = max_pair_mm * max_pair_mm;
-  int c = 0;
-  for (int i = 0; i < n; ++i) {
-    if (!valid_[static_cast<std::size_t>(i)]) continue;
-    for (int j = i + 1; j < n; ++j) {
-      if (!valid_[static_cast<std::size_t>(j)] || exclusive(i, j)) continue;
-      const double d2 = (X(i) - X(j)).squaredNorm();
-      if (d2 > max2) continue;
-      pairs_[static_cast<std::size_t>(c++)] =
-          PointPair{std::sqrt(d2), static_cast<std::int16_t>(i), static_cast<std::int16_t>(j)};
+  // One cell for everything when the pair limit is unbounded (a plain O(n^2) build).
+  cell_mm_ = !std::isfinite(max_pair_mm) ? 1e300 : std::max(max_pair_mm, 1e-3);
+  build_grid();
+  max_pair_mm_ = max_pair_mm;
+  pairs_ready_ = false;
+  pair_count_ = 0;
+  return stats;
+}
+
+void FramePoints::prepare_pairs() noexcept {
+  if (pairs_ready_) return;
+  build_pairs(max_pair_mm_ * max_pair_mm_);
+  pairs_ready_ = true;
+}
+
+int FramePoints::available_within(const Vec3& c, double radius_mm, std::int16_t* out,
+                                  int cap) const noexcept {
+  const double r2 = radius_mm * radius_mm;
+  int found = 0;
+  auto take = [&](int p) {
+    if ((X(p) - c).squaredNorm() < r2 && available(p)) {
+      if (found < cap) out[found] = static_cast<std::int16_t>(p);
+      ++found;
+    }
+  };
+  const auto lo = cell_of(c - Vec3::Constant(radius_mm));
+  const auto hi = cell_of(c + Vec3::Constant(radius_mm));
+  if (hi[0] - lo[0] > 2 || hi[1] - lo[1] > 2 || hi[2] - lo[2] > 2) {
+    for (int p = 0; p < n_; ++p) take(p);  // a radius beyond a cell: plain scan
+  } else {
+    std::array<std::uint32_t, 27> buckets{};
+    const int nbk = collect_buckets(
+        lo, hi, [this](const auto& cell) { return bucket_of(cell); }, buckets);
+    for (int q = 0; q < nbk; ++q) {
+      const std::uint32_t b = buckets[static_cast<std::size_t>(q)];
+      for (int e = bucket_start_[b]; e < bucket_start_[b + 1]; ++e)
+        take(bucket_points_[static_cast<std::size_t>(e)]);
     }
   }
-  pair_count_ = c;
-  std::sort(pairs_.begin(), pairs_.begin() + c,
-            [](const PointPair& a, const PointPair& b) { return a.d_mm < b.d_mm; });
-  return stats;
+  const int kept = std::min(found, cap);
+  for (int x = 1; x < kept; ++x)
+    for (int y = x; y > 0 && out[y - 1] > out[y]; --y) std::swap(out[y - 1], out[y]);
+  return found;
 }
 
 bool FramePoints::exclusive(int i, int j) const noexcept {
@@ -69,6 +215,17 @@ bool FramePoints::available(int i) const noexcept {
       return false;
   }
   return true;
+}
+
+int FramePoints::uses(int i) const noexcept {
+  const auto s = static_cast<std::size_t>(i);
+  int u = point_uses_[s];
+  for (int c = 0; c < kMaxCameras; ++c) {
+    const std::int16_t b = blob_[s][c];
+    if (b >= 0)
+      u = std::max<int>(u, blob_uses_[static_cast<std::size_t>(c)][static_cast<std::size_t>(b)]);
+  }
+  return u;
 }
 
 void FramePoints::acquire(int i) noexcept {

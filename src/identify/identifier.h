@@ -3,11 +3,17 @@
 // and the targets, precomputes the models, runs the ambiguity detection and sizes every
 // buffer; identify() is noexcept and allocation-free.
 // Per frame:
-//  1. temporal path (bodies with a recent pose): predict the pose (constant pose or
-//     constant velocity), match each predicted marker to the single available point in
-//     its gate, refit (Umeyama), validate (every residual < t, m >= warm_min_markers,
-//     every gate unique, no point shared with another body, speed limits); on failure the
-//     body falls back to the full search.
+//  1. temporal path (bodies with a recent pose; motion.h): predict the pose (constant
+//     velocity: the last screw motion continued; or constant pose), collect the available
+//     points within the gate around each predicted marker (the gate: the prediction error
+//     the stated limits allow over the time since the body was last seen, plus noise).
+//     One point in every gate and m >= warm_min_markers: nearest-neighbour match, refit
+//     (Umeyama), a second pass within min(t, gate) of the refit. Otherwise, or if that
+//     fails, the Eq. 1 search restricted to the gates (identification by continuity):
+//     its winner is accepted when no contradicting placement within the gates comes
+//     within ambiguity_ratio (a triangle that also fits another triangle of the target
+//     elsewhere is decided by where the body was). Validation: consistency test, speed
+//     limits; two warm bodies that share a point (or a blob) both fall back.
 //  2. full search (TargetSearch, the paper's Eq. 1) for the other bodies, on the points
 //     the temporal path did not take.
 //  3. conflicts: the pending body with the best (lowest) score whose solution is unique
@@ -18,11 +24,13 @@
 //  Every solution (and the rival that decides its uniqueness) passes the consistency test
 //  of consistency.h first: outlier markers dropped, solutions the noise cannot explain
 //  rejected.
-//  4. a pose that moved faster than max_speed_mm_per_s / max_angular_speed_deg_per_s
-//     since the body was last seen (the limits scale with that time) drops the body's
-//     track (counted); the solution, a fresh full search of this frame that passed the
-//     ambiguity and consistency tests, re-acquires ("boots") the body in the same frame.
-//  The temporal path's gate scales with the time since the body was last seen.
+//  4. a cold pose beyond the speed limits since the body was last seen (a jump, or a wrong
+//     identity of the track) drops the body's track (counted); the solution, a fresh full
+//     search of this frame that passed the ambiguity and consistency tests, re-acquires
+//     ("boots") the body in the same frame.
+// Cost: the temporal path queries a grid of the points (FramePoints), so a tracked body
+// costs the same whatever the number of bodies; only the bodies it did not take are
+// searched, over the neighbours of each seed's point.
 #pragma once
 
 #include <string>
@@ -34,6 +42,7 @@
 #include "identify/consistency.h"
 #include "identify/frame_points.h"
 #include "identify/identify_types.h"
+#include "identify/motion.h"
 #include "identify/target_model.h"
 #include "identify/target_search.h"
 
@@ -68,36 +77,40 @@ class Identifier {
   const IdentifyConfig& config() const noexcept { return config_; }
 
  private:
-  struct Track {
-    bool valid = false;
-    bool has_prev = false;
-    Iso3 T_last = Iso3::Identity();
-    std::int64_t t_last_ns = 0;
-    Iso3 T_prev = Iso3::Identity();
-    std::int64_t t_prev_ns = 0;
-  };
+  using Track = MotionTrack;
+  using MarkerPoints = std::array<std::int16_t, kMaxMarkers>;
 
   Identifier(const IdentifyConfig& config, std::vector<TargetModel> models,
              double marker_diameter_mm);
-  Iso3 predict(const Track& track, std::int64_t t_ns) const noexcept;
-  bool warm_match(int body, const Iso3& T_pred, SearchResult& out) noexcept;
-  bool within_speed_limits(const Track& track, const Iso3& T, std::int64_t t_ns) const noexcept;
-  using MarkerPoints = std::array<std::int16_t, kMaxMarkers>;
+  // Temporal path of one body (identifier_temporal.cpp): true when res(body) holds a
+  // validated solution; gated_[body] tells whether the gated search decided it.
+  bool temporal_match(int body, std::int64_t t_ns) noexcept;
+  bool nearest_match(int body, const Iso3& T_pred, const std::array<double, kMaxMarkers>& gate_mm,
+                     SearchResult& out) noexcept;
+  bool gated_search(int body, SearchResult& out) noexcept;
+  // Consistency test of a found solution and of its rival (false: rejected, counted).
+  bool settle(int body, int min_m, SearchResult& r) noexcept;
   bool points_available(const MarkerPoints& pm, int k) const noexcept;
   void acquire_points(const MarkerPoints& pm, int k) noexcept;
-  bool conflicts(const SearchResult& a, int ka, const SearchResult& b, int kb) const noexcept;
+  void release_points(const MarkerPoints& pm, int k) noexcept;
+  void resolve_warm_conflicts() noexcept;
+  void resolve_pending(std::int64_t t_ns) noexcept;
   void full_search(int body) noexcept;
 
   IdentifyConfig config_;
   std::vector<TargetModel> models_;
   double max_pair_mm_ = 0.0;
-  double warm_gate_mm_ = 0.0;  // this body's warm gate in this frame (age-scaled)
+  MotionBounds motion_;
   FramePoints frame_;
   TargetSearch search_;
   ConsistencyGate gate_;
   std::vector<Track> tracks_;
   std::vector<SearchResult> results_;
-  std::vector<std::uint8_t> state_;  // per body, per frame (see identifier.cpp)
+  std::vector<std::uint8_t> state_;    // per body, per frame (see identifier.cpp)
+  std::vector<std::uint8_t> gated_;    // per body, this frame: decided by the gated search
+  std::vector<std::int16_t> pending_;  // bodies awaiting the conflict resolution
+  int pending_count_ = 0;
+  MarkerCandidates cand_;  // the gates' points of the body on the temporal path
   IdentifyCounters counters_;
   std::vector<std::string> warnings_;
   std::vector<AmbiguityFinding> ambiguities_;

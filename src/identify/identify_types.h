@@ -15,8 +15,8 @@
 namespace mocap {
 
 inline constexpr int kMaxMarkers = 16;      // markers per target
-inline constexpr int kMaxBodies = 16;       // targets per Identifier
-inline constexpr int kMaxPoints = 256;      // measured 3D points per frame (hard bound)
+inline constexpr int kMaxBodies = 32;       // targets per Identifier (the whole robot, or two)
+inline constexpr int kMaxPoints = 512;      // measured 3D points per frame (hard bound)
 inline constexpr int kMaxBestPairs = 1024;  // bound of IdentifyConfig::best_pairs
 
 // One triangulated 3D point. blob_index[c] is the blob of camera c of the rig it was
@@ -72,11 +72,20 @@ struct IdentifyConfig {
   // --- temporal path ---
   bool temporal = true;  // use the previous pose as a prior
   MotionModel motion_model = MotionModel::kConstantVelocity;
-  double warm_gate_mm = 15.0;                   // nearest-neighbour gate around predicted markers
-  int warm_min_markers = 4;                     // fewer matched markers -> full search instead
-  double max_prior_age_s = 0.25;                // older prior -> full search
-  double max_speed_mm_per_s = 10000.0;          // <= 0 disables the check
-  double max_angular_speed_deg_per_s = 3600.0;  // <= 0 disables the check
+  // The gate around each predicted marker is derived from the limits below, the time
+  // since the body was last seen and point_sigma_mm (motion.h); warm_gate_mm is the gate
+  // only when no limit bounds the motion (speed limits and acceleration all <= 0).
+  double warm_gate_mm = 15.0;
+  // Nearest-neighbour matches (one point in every gate) need this many markers; fewer, or
+  // several points in a gate: the Eq. 1 search restricted to the gates decides (>= 3).
+  int warm_min_markers = 4;
+  double max_prior_age_s = 0.25;  // older prior -> full search
+  // Stated limits of the motion: the fastest marker, the fastest rotation (<= 0: none).
+  double max_speed_mm_per_s = 10000.0;
+  double max_angular_speed_deg_per_s = 3600.0;
+  // Largest acceleration of a marker (mm/s^2) that the constant-velocity gate allows;
+  // 0: max_speed * max_angular_speed (a marker at the speed limit turning at the limit).
+  double max_acceleration_mm_per_s2 = 0.0;
   // --- load time ---
   AmbiguityPolicy ambiguity_policy = AmbiguityPolicy::kWarn;
 };
@@ -103,9 +112,12 @@ struct BodyPoses {
 struct IdentifyCounters {
   std::uint64_t frames = 0;
   std::uint64_t bodies_found = 0;
-  std::uint64_t full_searches = 0;        // Eq. 1 searches run (including re-searches)
-  std::uint64_t warm_accepted = 0;        // bodies found by the temporal path
-  std::uint64_t warm_fallbacks = 0;       // prior present but validation failed -> search
+  std::uint64_t full_searches = 0;   // Eq. 1 searches run (including re-searches)
+  std::uint64_t warm_accepted = 0;   // bodies found by the temporal path
+  std::uint64_t warm_fallbacks = 0;  // prior present but validation failed -> search
+  // of warm_accepted: decided by the search within the gates (several points in a gate,
+  // or fewer than warm_min_markers), e.g. a triangle that also fits elsewhere in the target
+  std::uint64_t continuity_resolved = 0;
   std::uint64_t conflict_researches = 0;  // a body lost points to a better body: re-searched
   std::uint64_t velocity_rejects = 0;     // pose jumped beyond the limits: track dropped
   std::uint64_t jump_reboots = 0;         // of those, re-acquired by the cold solution (same frame)

@@ -61,6 +61,10 @@ Expected<void> validate_config(const IdentifyConfig& c) {
   if (!(c.max_prior_age_s > 0.0))
     return make_error(f, "max_prior_age_s", "must be > 0, got " + num(c.max_prior_age_s));
   if (std::isnan(c.max_speed_mm_per_s)) return make_error(f, "max_speed_mm_per_s", "is NaN");
+  if (!(c.max_acceleration_mm_per_s2 >= 0.0))
+    return make_error(f, "max_acceleration_mm_per_s2",
+                      "must be >= 0 (0: derived from the speed limits), got " +
+                          num(c.max_acceleration_mm_per_s2));
   if (std::isnan(c.max_angular_speed_deg_per_s))
     return make_error(f, "max_angular_speed_deg_per_s", "is NaN");
   return {};

@@ -44,15 +44,45 @@ void TargetSearch::collect_seeds(const TargetModel& model, const FramePoints& fr
   const double t = config_.t_mm;
   const PointPair* pp = frame.pairs();
   const int np = frame.pair_count();
+  const auto cap = static_cast<int>(heap_.size());
   int lo = 0;  // first measured pair with D > d - t (monotone: model pairs are sorted)
   for (const ModelPair& mp : model.pairs_sorted) {
     while (lo < np && pp[lo].d_mm <= mp.d_mm - t) ++lo;
     for (int q = lo; q < np && pp[q].d_mm < mp.d_mm + t; ++q) {
       const PointPair& p = pp[q];
-      if (!frame.available(p.i) || !frame.available(p.j)) continue;
       const double disc = std::abs(p.d_mm - mp.d_mm);
+      // A full heap keeps only better ones: skip before the (costlier) availability test.
+      if (heap_size_ == cap && !(disc < heap_.front().disc_mm)) {
+        stats.seeds_dropped += 2;
+        continue;
+      }
+      if (!frame.available(p.i) || !frame.available(p.j)) continue;
       push_seed(Seed{disc, p.i, p.j, mp.a, mp.b}, stats);
       push_seed(Seed{disc, p.j, p.i, mp.a, mp.b}, stats);
+    }
+  }
+  std::sort_heap(heap_.begin(), heap_.begin() + heap_size_, kSeedLess);
+  stats.seeds = heap_size_;
+}
+
+void TargetSearch::collect_gated_seeds(const TargetModel& model, const FramePoints& frame,
+                                       SearchStats& stats) noexcept {
+  heap_size_ = 0;
+  const double t = config_.t_mm;
+  const MarkerCandidates& g = *gated_;
+  for (const ModelPair& mp : model.pairs_sorted) {
+    const auto a = static_cast<std::size_t>(mp.a), b = static_cast<std::size_t>(mp.b);
+    for (int u = 0; u < g.count[a]; ++u) {
+      const int p = g.point[a][static_cast<std::size_t>(u)];
+      for (int v = 0; v < g.count[b]; ++v) {
+        const int q = g.point[b][static_cast<std::size_t>(v)];
+        if (p == q || !frame.available(p) || !frame.available(q) || frame.exclusive(p, q)) continue;
+        const double disc = std::abs((frame.X(p) - frame.X(q)).norm() - mp.d_mm);
+        if (disc < t)
+          push_seed(
+              Seed{disc, static_cast<std::int16_t>(p), static_cast<std::int16_t>(q), mp.a, mp.b},
+              stats);
+      }
     }
   }
   std::sort_heap(heap_.begin(), heap_.begin() + heap_size_, kSeedLess);
@@ -119,8 +149,13 @@ void TargetSearch::extend(int level, double sum_sq) noexcept {
   const double d0 = model.dist_mm[cs][static_cast<std::size_t>(slot_marker_[0])];
   const double lo2 = d0 > t ? (d0 - t) * (d0 - t) : 0.0;
   const double hi2 = (d0 + t) * (d0 + t);
-  const int n = frame.size();
-  for (int p = 0; p < n; ++p) {
+  // Candidates: the marker's gate (gated mode), else the neighbours of the first slot's
+  // point (every point closer than the longest pair + t; the others fail q2 < hi2).
+  const std::int16_t* cand =
+      gated_ != nullptr ? gated_->point[cs].data() : frame.neighbours(slot_point_[0]);
+  const int nc = gated_ != nullptr ? gated_->count[cs] : frame.neighbour_count(slot_point_[0]);
+  for (int e = 0; e < nc; ++e) {
+    const int p = cand[e];
     const double q2 = (frame.X(p) - X0).squaredNorm();
     if (q2 <= lo2 || q2 >= hi2 || !frame.available(p)) continue;
     bool ok = true;
@@ -260,16 +295,22 @@ void TargetSearch::run_pass() noexcept {
 }
 
 bool TargetSearch::run(const TargetModel& model, FramePoints& frame, SearchResult& out,
-                       SearchStats& stats) noexcept {
+                       SearchStats& stats, const MarkerCandidates* gated) noexcept {
   out = SearchResult{};
   out.point_of_marker.fill(-1);
   stats = SearchStats{};
   model_ = &model;
   frame_ = &frame;
+  gated_ = gated;
   best_ = &out;
   nodes_ = 0;
   limit_hit_ = false;
-  collect_seeds(model, frame, stats);
+  if (gated != nullptr) {
+    collect_gated_seeds(model, frame, stats);
+  } else {
+    frame.prepare_pairs();
+    collect_seeds(model, frame, stats);
+  }
   rival_pass_ = false;
   run_pass();
   out.rival_score = std::numeric_limits<double>::infinity();

@@ -16,6 +16,10 @@
 //     points a winner's point excludes, or with the union not rigidly consistent),
 //     pruned at ambiguity_ratio * best score. The caller rejects a
 //     winner whose rival is that close: an ambiguous frame gives no identity at all.
+//  Gated mode (the temporal path, identification by continuity): each marker may only
+//  take one of the points given for it (those within the gate around its predicted
+//  position), for the seeds and the extension alike; winner and rival are then the best
+//  and the best contradicting placement within the gates.
 //  4. Pruning that never loses the optimum of the explored seeds: a branch stops when a
 //     lower bound of any completion's score (|r| cannot shrink when points are added to a
 //     least-squares fit) is not better than the best so far; a correspondence pair that
@@ -45,9 +49,16 @@ struct SearchResult {
   bool unique(double ratio) const noexcept { return ratio <= 1.0 || rival_score >= ratio * score; }
 };
 
+// The points a marker may take in a gated search (ascending index, at most kMax each).
+struct MarkerCandidates {
+  static constexpr int kMax = 8;
+  std::array<std::array<std::int16_t, kMax>, kMaxMarkers> point{};
+  std::array<std::int8_t, kMaxMarkers> count{};
+};
+
 struct SearchStats {
   int seeds = 0;          // 2-matchings kept
-  int seeds_dropped = 0;  // 2-matchings beyond best_pairs
+  int seeds_dropped = 0;  // 2-matchings not kept (beyond best_pairs)
   int nodes = 0;          // extension steps visited
   bool node_limit_hit = false;
 };
@@ -60,9 +71,9 @@ class TargetSearch {
   explicit TargetSearch(const IdentifyConfig& config, double same_ball_mm = 0.0);
 
   // Searches `model` among the available points of `frame` (occupancy is restored on
-  // return). Returns out.found.
-  bool run(const TargetModel& model, FramePoints& frame, SearchResult& out,
-           SearchStats& stats) noexcept;
+  // return). Returns out.found. With `gated`, marker c only takes gated->point[c][..].
+  bool run(const TargetModel& model, FramePoints& frame, SearchResult& out, SearchStats& stats,
+           const MarkerCandidates* gated = nullptr) noexcept;
 
  private:
   struct Seed {
@@ -72,6 +83,8 @@ class TargetSearch {
   };
   void collect_seeds(const TargetModel& model, const FramePoints& frame,
                      SearchStats& stats) noexcept;
+  void collect_gated_seeds(const TargetModel& model, const FramePoints& frame,
+                           SearchStats& stats) noexcept;
   void push_seed(const Seed& s, SearchStats& stats) noexcept;
   void extend(int level, double sum_sq) noexcept;
   void run_pass() noexcept;
@@ -92,6 +105,7 @@ class TargetSearch {
   // Current search state.
   const TargetModel* model_ = nullptr;
   FramePoints* frame_ = nullptr;
+  const MarkerCandidates* gated_ = nullptr;
   int m_ = 0;
   std::array<std::int8_t, kMaxMarkers> slot_marker_{};
   std::array<std::int16_t, kMaxMarkers> slot_point_{};

@@ -116,7 +116,7 @@ inline constexpr std::array<CounterField<MultiViewCounters>, 14> kMultiViewField
 }};
 
 // Reported as identify_<name>.
-inline constexpr std::array<CounterField<IdentifyCounters>, 17> kIdentifyFields = {{
+inline constexpr std::array<CounterField<IdentifyCounters>, 18> kIdentifyFields = {{
     MOCAP_COUNTER_FIELD(IdentifyCounters, frames),
     MOCAP_COUNTER_FIELD(IdentifyCounters, bodies_found),
     MOCAP_COUNTER_FIELD(IdentifyCounters, full_searches),
@@ -134,10 +134,11 @@ inline constexpr std::array<CounterField<IdentifyCounters>, 17> kIdentifyFields 
     MOCAP_COUNTER_FIELD(IdentifyCounters, consistency_rejects),
     MOCAP_COUNTER_FIELD(IdentifyCounters, partial_excluded),
     MOCAP_COUNTER_FIELD(IdentifyCounters, partial_rejects),
+    MOCAP_COUNTER_FIELD(IdentifyCounters, continuity_resolved),
 }};
 
 // Reported as chain_<name>, with a kinematic model.
-inline constexpr std::array<CounterField<ChainCounters>, 9> kChainFields = {{
+inline constexpr std::array<CounterField<ChainCounters>, 11> kChainFields = {{
     MOCAP_COUNTER_FIELD(ChainCounters, frames),
     MOCAP_COUNTER_FIELD(ChainCounters, attempts),
     MOCAP_COUNTER_FIELD(ChainCounters, joints_solved),
@@ -147,6 +148,8 @@ inline constexpr std::array<CounterField<ChainCounters>, 9> kChainFields = {{
     MOCAP_COUNTER_FIELD(ChainCounters, chi2_rejects),
     MOCAP_COUNTER_FIELD(ChainCounters, uncertain_rejects),
     MOCAP_COUNTER_FIELD(ChainCounters, node_limit_hits),
+    MOCAP_COUNTER_FIELD(ChainCounters, pose_refits),
+    MOCAP_COUNTER_FIELD(ChainCounters, pose_rejects),
 }};
 #undef MOCAP_COUNTER_FIELD
 

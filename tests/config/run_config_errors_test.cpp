@@ -195,7 +195,7 @@ const ErrorCase kCases[] = {
     {"LoopFramesRange", "sim: {loop_frames: 1}\n",
      "sim.loop_frames: must be in [2, 2000], got 1 (line 1)"},
     {"UnknownScene", "sim: {scene: arms}\n",
-     "sim.scene: expected limbs|stalks, got 'arms' (line 1)"},
+     "sim.scene: expected limbs|stalks|humanoid, got 'arms' (line 1)"},
     {"SceneWithHardware", V4L2_PAIR ASSETS "sim: {scene: stalks}\n",
      "sim.scene: only used by the sim backend (cameras use v4l2) (line 6)"},
     {"StatusInterval", "service: {status_interval_s: 0}\n",

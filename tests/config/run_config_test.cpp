@@ -185,6 +185,29 @@ TEST(RunConfig, SimSceneSelectsTheMarkerLayout) {
   EXPECT_TRUE(check_tracking_assets(*cfg));
 }
 
+// sim: {scene: humanoid}: the whole robot on its ring of 8 cameras and a 100-frame loop
+// by default (each frame is 8 x 1280x1024 images); sim.cameras and loop_frames still rule.
+TEST(RunConfig, SimHumanoidDefaultsToItsRing) {
+  TempDir dir("cfg_humanoid");
+  write_file(dir.file("h.yaml"), "sim: {scene: humanoid}\n");
+  auto cfg = load_run_config(dir.file("h.yaml"));
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  EXPECT_EQ(cfg->sim.scene, sim::SceneKind::kHumanoid);
+  EXPECT_EQ(cfg->cameras.size(), 8u);
+  EXPECT_EQ(cfg->sim.loop_frames, kHumanoidLoopFrames);
+  write_file(dir.file("h4.yaml"), "sim: {scene: humanoid, cameras: 4, loop_frames: 10}\n");
+  auto four = load_run_config(dir.file("h4.yaml"));
+  ASSERT_TRUE(four) << four.error().message;
+  EXPECT_EQ(four->cameras.size(), 4u);
+  EXPECT_EQ(four->sim.loop_frames, 10);
+  const sim::SimOptions so = sim_options(*four);
+  auto scene = sim::make_scene(so);
+  ASSERT_TRUE(scene) << scene.error().message;
+  EXPECT_EQ(scene->body_count(), 15);
+  EXPECT_EQ(scene->rig.cameras.size(), 4u);
+  EXPECT_TRUE(check_tracking_assets(*four));
+}
+
 TEST(RunConfig, HostPortCheck) {
   EXPECT_TRUE(check_host_port("f", "k", "127.0.0.1:7755"));
   EXPECT_TRUE(check_host_port("f", "k", "[::1]:1"));
