@@ -131,6 +131,15 @@ void add_joint(SimScene& scene, const std::string& name, JointType type, int par
   scene.joints_true.joints.push_back(std::move(j));
 }
 
+void limb_azimuth_frame(const Vec3& a, const Vec3& b, Vec3& d, Vec3& front, Vec3& side) {
+  d = (b - a).normalized();
+  const Vec3 up = d.z() < 0.0 ? Vec3(-d) : d;
+  front = Vec3(0.0, -1.0, 0.0) - up.dot(Vec3(0.0, -1.0, 0.0)) * up;
+  if (front.norm() < 0.3) front = Vec3::UnitZ() - up.z() * up;
+  front.normalize();
+  side = -front.cross(up);
+}
+
 void place_glints(const SceneOptions& options, SimScene& scene) {
   Rng rng(hash_mix(options.seed, 0x6C696E74ull));
   const double scale = static_cast<double>(scene.imaging.maxval) / 255.0;
@@ -156,14 +165,9 @@ void place_glints(const SceneOptions& options, SimScene& scene) {
     spot.lobes[0].head<2>().setZero();
     if (limb == nullptr) continue;
     const Vec3 a = T_wb * limb->a_body, e = T_wb * limb->b_body;
-    // The azimuth is measured about the limb axis from the side facing -Y (the front),
-    // + towards +X; for a vertical limb that is radial_dir(phi).
-    Vec3 d = (e - a).normalized();
-    if (d.z() < 0.0) d = -d;
-    Vec3 front = Vec3(0.0, -1.0, 0.0) - d.dot(Vec3(0.0, -1.0, 0.0)) * d;
-    if (front.norm() < 0.3) front = Vec3::UnitZ() - d.z() * d;
-    front.normalize();
-    const Vec3 side = -front.cross(d);  // +X for a vertical limb
+    // The azimuth about the limb axis; for a vertical limb that is radial_dir(phi).
+    Vec3 d, front, side;
+    limb_azimuth_frame(a, e, d, front, side);
     const Vec3 dir = std::sin(phi_deg * kRadPerDeg) * side + std::cos(phi_deg * kRadPerDeg) * front;
     const Vec3 axis_pt = a + s * (e - a);
     const Iso3 T_body_world = T_wb.inverse();

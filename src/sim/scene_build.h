@@ -33,6 +33,11 @@ void add_joint(SimScene& scene, const std::string& name, JointType type, int par
                const Vec3& center_world, const Vec3& axis_world, const Mat3& R_parent_cmd,
                const Vec3& lower_rad, const Vec3& upper_rad);
 
+// The frame that azimuths about a limb from a to b are measured in (world, reference
+// pose): d along the limb, front = the side facing -Y (for a limb along Y: the top),
+// side = +X for a vertical limb; azimuth phi points to sin(phi) side + cos(phi) front.
+void limb_azimuth_frame(const Vec3& a, const Vec3& b, Vec3& d, Vec3& front, Vec3& side);
+
 // Places options.stray_glints shiny spots on the bodies' main capsules (the first
 // capsule of each body), from the seed.
 void place_glints(const SceneOptions& options, SimScene& scene);

@@ -4,7 +4,6 @@
 // target-design rules, and the joints are added in topological order from the pelvis.
 #include "sim/scene_humanoid.h"
 
-#include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -12,44 +11,16 @@
 
 #include "core/rotation.h"
 #include "core/units.h"
+#include "sim/limb_layout.h"
 #include "sim/scene_build.h"
 #include "sim/scene_cameras.h"
-#include "sim/sim_rng.h"
 
 namespace mocap::sim {
 namespace {
 
-constexpr double kBallRadiusMm = 7.0;       // 14 mm balls
-constexpr double kPostRadiusMm = 2.0;       // the bases holding them
-constexpr double kMinBallGapMm = 40.0;      // centre distance between two balls of a target
-constexpr double kMinDistanceStepMm = 4.0;  // inter-marker distances of a target differ by this
-// No triangle of a target fits another triangle of the same target (any correspondence,
-// after the best rigid motion) within this RMS (the identifier's t = 5 mm with margin):
-// no target is symmetric. Across targets only near-exact copies are ruled out, as a lab
-// rules out identical targets: a triangle of one limb may still fit one of another
-// within t, which the tracker must resolve (continuity, the other markers).
-constexpr double kTriangleFitMm = 5.5;
-constexpr double kCrossTriangleFitMm = 2.5;
-constexpr std::uint64_t kLayoutSeed = 0x68756D616E6F6964ull;  // the robot's, not --seed's
-
-// A limb in the world at the reference pose.
-struct Limb {
-  Vec3 a, b;
-  double radius_mm;
-};
-
-// One body: its limbs (the first carries the markers), how many markers and where on
-// the main limb they may sit (fraction of its length, azimuth interval about its axis:
-// 0 faces the front (-Y; the top for a limb along Y), +90 is +X for a vertical limb).
-struct BodyDef {
-  const char* name;
-  int parent;  // -1: the root
-  std::vector<Limb> limbs;
-  int markers;
-  double s_lo, s_hi;
-  double phi_lo_deg, phi_hi_deg;
-  Vec3 frame_rot_deg;  // the body frame's deliberate rotation (z, x, y applied in turn)
-};
+constexpr double kPostRadiusMm = 2.0;  // the bases holding the balls
+// The target-design rules (limb_layout.h); the seed is the robot's, not --seed's.
+constexpr LayoutRules kRules{7.0, 40.0, 4.0, 5.5, 2.5, 2.0, 0x68756D616E6F6964ull};
 
 struct JointDef {
   const char* name;
@@ -61,18 +32,8 @@ struct JointDef {
   Vec3 hi_deg;
 };
 
-// The azimuth frame about a limb axis (as place_glints measures it).
-void limb_frame(const Limb& l, Vec3& d, Vec3& front, Vec3& side) {
-  d = (l.b - l.a).normalized();
-  Vec3 up = d.z() < 0.0 ? Vec3(-d) : d;
-  front = Vec3(0.0, -1.0, 0.0) - up.dot(Vec3(0.0, -1.0, 0.0)) * up;
-  if (front.norm() < 0.3) front = Vec3::UnitZ() - up.z() * up;
-  front.normalize();
-  side = -front.cross(up);
-}
-
-std::vector<BodyDef> humanoid_bodies() {
-  std::vector<BodyDef> b;
+std::vector<LimbBody> humanoid_bodies() {
+  std::vector<LimbBody> b;
   // name, parent, limbs, markers, s range, azimuth range, frame rotation
   // The pelvis carries no ball underneath, between the legs.
   b.push_back(
@@ -234,146 +195,6 @@ std::vector<JointDef> humanoid_joints() {
   return j;
 }
 
-// A triangle of balls: its corners and its sorted side lengths (a cheap pre-test: two
-// triangles whose sorted sides differ by more than 2 sqrt(3) x the fit RMS cannot fit).
-struct Triangle {
-  Eigen::Matrix3d corners;  // columns
-  std::array<double, 3> sides;
-};
-
-Triangle triangle(const Vec3& a, const Vec3& b, const Vec3& c) {
-  Triangle t;
-  t.corners << a, b, c;
-  t.sides = {(a - b).norm(), (b - c).norm(), (a - c).norm()};
-  std::sort(t.sides.begin(), t.sides.end());
-  return t;
-}
-
-// Whether y fits x within rms_mm under some correspondence and rigid motion (with
-// `self`, x and y are one triangle and the identity correspondence does not count: a
-// nearly isosceles triangle fits itself turned over).
-bool triangles_match(const Triangle& x, const Triangle& y, double rms_mm, bool self = false) {
-  for (std::size_t i = 0; i < 3; ++i) {
-    if (std::abs(x.sides[i] - y.sides[i]) > 2.0 * std::sqrt(3.0) * rms_mm) return false;
-  }
-  std::array<int, 3> perm = {0, 1, 2};
-  do {
-    if (self && perm == std::array<int, 3>{0, 1, 2}) continue;
-    Eigen::Matrix3d src;
-    for (int k = 0; k < 3; ++k) src.col(k) = y.corners.col(perm[static_cast<std::size_t>(k)]);
-    const Eigen::Matrix4d T = Eigen::umeyama(src, x.corners, false);
-    const Eigen::Matrix3d moved =
-        (T.topLeftCorner<3, 3>() * src).colwise() + T.topRightCorner<3, 1>();
-    if (std::sqrt((moved - x.corners).squaredNorm() / 3.0) < rms_mm) return true;
-  } while (std::next_permutation(perm.begin(), perm.end()));
-  return false;
-}
-
-// The triangles of a point set (world, reference pose).
-std::vector<Triangle> triangles_of(const std::vector<Vec3>& p) {
-  std::vector<Triangle> t;
-  for (std::size_t i = 0; i < p.size(); ++i)
-    for (std::size_t j = i + 1; j < p.size(); ++j)
-      for (std::size_t k = j + 1; k < p.size(); ++k) t.push_back(triangle(p[i], p[j], p[k]));
-  return t;
-}
-
-struct Mount {
-  Vec3 center, post_root;
-};
-
-// Distance from p to the segment a-b.
-double segment_distance(const Vec3& p, const Vec3& a, const Vec3& b) {
-  const Vec3 ab = b - a;
-  const double s = std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
-  return (p - (a + s * ab)).norm();
-}
-
-// A ball clears every limb of the robot but its own main limb by 2 mm.
-bool ball_clears(const Vec3& c, const std::vector<BodyDef>& all, const BodyDef& own) {
-  for (const BodyDef& b : all) {
-    for (std::size_t i = 0; i < b.limbs.size(); ++i) {
-      if (&b == &own && i == 0) continue;
-      const Limb& l = b.limbs[i];
-      if (segment_distance(c, l.a, l.b) < l.radius_mm + kBallRadiusMm + 2.0) return false;
-    }
-  }
-  return true;
-}
-
-// A layout for one body that passes the design rules against the targets placed so
-// far (their triangles in `placed`). Deterministic: the rng is the robot's.
-Expected<std::vector<Mount>> search_layout(const std::vector<BodyDef>& all, const BodyDef& body,
-                                           Rng& rng, const std::vector<Triangle>& placed) {
-  const Limb& main = body.limbs[0];
-  Vec3 d, front, side;
-  limb_frame(main, d, front, side);
-  const double len = (main.b - main.a).norm();
-  const int n = body.markers;
-  for (int attempt = 0; attempt < 1000000; ++attempt) {
-    std::vector<Mount> mounts;
-    std::vector<Vec3> centers;
-    const double span = body.phi_hi_deg - body.phi_lo_deg;
-    const double phase = rng.uniform(0.0, 1.0);
-    for (int k = 0; k < n; ++k) {
-      // Azimuths spread all around the allowed arc, heights spread along the limb.
-      const double u = (k + phase + rng.uniform(-0.3, 0.3)) / n;
-      const double phi = body.phi_lo_deg + span * (u - std::floor(u));
-      const double s = body.s_lo + (body.s_hi - body.s_lo) * rng.uniform(0.0, 1.0);
-      const double gap = 3.0 + std::floor(rng.uniform(0.0, 3.0));
-      const Vec3 dir = std::sin(phi * kRadPerDeg) * side + std::cos(phi * kRadPerDeg) * front;
-      const Vec3 axis_pt = main.a + s * len * d;
-      const Vec3 center = axis_pt + dir * (main.radius_mm + gap + kBallRadiusMm);
-      mounts.push_back({center, axis_pt + dir * (main.radius_mm - 3.0)});
-      centers.push_back(center);
-    }
-    bool ok = true;
-    for (int k = 0; k < n && ok; ++k)
-      ok = ball_clears(centers[static_cast<std::size_t>(k)], all, body);
-    if (!ok) continue;
-    std::vector<double> dist;
-    for (int i = 0; i < n && ok; ++i) {
-      for (int j = i + 1; j < n && ok; ++j) {
-        const double dij =
-            (centers[static_cast<std::size_t>(i)] - centers[static_cast<std::size_t>(j)]).norm();
-        ok = dij >= kMinBallGapMm;
-        dist.push_back(dij);
-      }
-    }
-    if (!ok) continue;
-    std::sort(dist.begin(), dist.end());
-    for (std::size_t i = 1; i < dist.size() && ok; ++i)
-      ok = dist[i] - dist[i - 1] >= kMinDistanceStepMm;
-    if (!ok) continue;
-    const auto own = triangles_of(centers);
-    for (std::size_t i = 0; i < own.size() && ok; ++i) {
-      for (std::size_t j = i; j < own.size() && ok; ++j)
-        ok = !triangles_match(own[i], own[j], kTriangleFitMm, i == j);
-      for (std::size_t j = 0; j < placed.size() && ok; ++j)
-        ok = !triangles_match(own[i], placed[j], kCrossTriangleFitMm);
-    }
-    if (ok) return mounts;
-  }
-  return make_error("simulate", "scene",
-                    std::string("humanoid: no marker layout found for '") + body.name + "'");
-}
-
-// Every body's layout in turn, each against the triangles of the ones before.
-Expected<std::vector<std::vector<Mount>>> search_robot_layout(const std::vector<BodyDef>& bodies) {
-  Rng rng(kLayoutSeed);
-  std::vector<Triangle> placed;
-  std::vector<std::vector<Mount>> layout;
-  for (const BodyDef& body : bodies) {
-    auto mounts = search_layout(bodies, body, rng, placed);
-    if (!mounts) return mounts.error();
-    std::vector<Vec3> centers;
-    for (const Mount& m : *mounts) centers.push_back(m.center);
-    for (const auto& t : triangles_of(centers)) placed.push_back(t);
-    layout.push_back(std::move(mounts).value());
-  }
-  return layout;
-}
-
 Mat3 frame_rotation(const Vec3& deg) {
   return rot_z(deg.x() * kRadPerDeg) * rot_x(deg.y() * kRadPerDeg) * rot_y(deg.z() * kRadPerDeg);
 }
@@ -432,13 +253,13 @@ Expected<SimScene> build_humanoid_scene(const SceneOptions& options) {
   scene.imaging = options.imaging;
   // The lab sets strobe and exposure for its volume: the default peak at 3 m.
   scene.imaging.reference_distance_mm = 3000.0;
-  scene.marker_radius_mm = kBallRadiusMm;
-  scene.targets.marker_diameter_mm = 2.0 * kBallRadiusMm;
+  scene.marker_radius_mm = kRules.ball_radius_mm;
+  scene.targets.marker_diameter_mm = 2.0 * kRules.ball_radius_mm;
   scene.robot_center_world = Vec3(0.0, 0.0, 850.0);
   scene.root_body = 0;
 
-  const std::vector<BodyDef> bodies = humanoid_bodies();
-  for (const BodyDef& b : bodies) {
+  const std::vector<LimbBody> bodies = humanoid_bodies();
+  for (const LimbBody& b : bodies) {
     const Limb& main = b.limbs[0];
     scene.T_world_body_ref.push_back(
         make_iso(frame_rotation(b.frame_rot_deg), 0.5 * (main.a + main.b)));
@@ -447,7 +268,8 @@ Expected<SimScene> build_humanoid_scene(const SceneOptions& options) {
     scene.targets.bodies.push_back(std::move(t));
   }
   // The layout is the robot's: searched once per process.
-  static const Expected<std::vector<std::vector<Mount>>> layout = search_robot_layout(bodies);
+  static const Expected<std::vector<std::vector<Mount>>> layout =
+      search_limb_layout(bodies, kRules);
   if (!layout) return layout.error();
   for (std::size_t bi = 0; bi < bodies.size(); ++bi) {
     const int b = static_cast<int>(bi);
