@@ -28,7 +28,7 @@ void ParallelDetect::detect_share(int first_camera) noexcept {
 }
 
 void ParallelDetect::run() noexcept {
-  std::uint64_t seen = 0;
+  std::uint32_t seen = 0;
   for (;;) {
     // acquire: pairs with the caller's release increment, so views_ and out_ (and
     // stop_) written before it are visible here.
@@ -48,11 +48,11 @@ bool ParallelDetect::process(std::span<const ImageView* const> views, std::int64
   views_ = views;
   out_ = &out;
   // release: publishes views_ and out_ to the worker (see run()).
-  const std::uint64_t frame = posted_.fetch_add(1, std::memory_order_release) + 1;
+  const std::uint32_t frame = posted_.fetch_add(1, std::memory_order_release) + 1;
   posted_.notify_one();
   detect_share(0);
   // acquire: pairs with the worker's release store; its blob lists are complete.
-  for (std::uint64_t d = done_.load(std::memory_order_acquire); d != frame;
+  for (std::uint32_t d = done_.load(std::memory_order_acquire); d != frame;
        d = done_.load(std::memory_order_acquire))
     done_.wait(d, std::memory_order_acquire);
   out.times.detect = monotonic_ns() - t0;

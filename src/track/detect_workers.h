@@ -5,9 +5,10 @@
 // identification, angles) then run on the calling thread. The output is exactly
 // FrameProcessor::process's: every camera has its own detector and blob list, and
 // detect_camera() is thread-safe between different cameras.
-// One handshake per frame through two counters (C++20 atomic wait/notify, a futex: no
-// lock, no allocation after construction). Timings are wall-clock, as in process():
-// `detect` is the time until every camera of the frame was detected.
+// One handshake per frame through two 32-bit counters (C++20 atomic wait/notify: a futex
+// on int-sized atomics, no lock; no allocation after construction; the counters wrap and
+// are only compared for equality). Timings are wall-clock, as in process(): `detect` is
+// the time until every camera of the frame was detected.
 #pragma once
 
 #include <atomic>
@@ -40,8 +41,8 @@ class ParallelDetect {
   // by the worker after its acquire load.
   std::span<const ImageView* const> views_;
   FrameOutput* out_ = nullptr;
-  std::atomic<std::uint64_t> posted_{0};  // frames handed to the worker
-  std::atomic<std::uint64_t> done_{0};    // frames whose odd cameras the worker detected
+  std::atomic<std::uint32_t> posted_{0};  // frames handed to the worker
+  std::atomic<std::uint32_t> done_{0};    // frames whose odd cameras the worker detected
   std::atomic<bool> stop_{false};
   std::thread worker_;
 };
