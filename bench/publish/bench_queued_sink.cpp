@@ -1,5 +1,5 @@
 // Design: what a QueuedSink costs the real-time publish thread per frame. Three cases:
-// the floor (one FrameResult copy, ~13 KB, into a preallocated buffer: what any queued
+// the floor (one FrameResult copy, ~55.6 KiB, into a preallocated buffer: what any queued
 // hand-off must pay), publish() while the worker is blocked inside encode() (queue full:
 // copy + drop-oldest), and publish() to a worker that is asleep between its polls (the
 // common case at 100 fps; since 2026-12-02 no wake syscall either: the worker polls every

@@ -7,8 +7,10 @@
 //     from a pre-rendered simulator loop (ping-pong, so the motion stays continuous);
 //     the latency is the call's wall time.
 //   pipeline mode (--pipeline): the live pipeline (five threads, simulated cameras,
-//     lockstep pacing as fast as it goes); the latency is trigger -> identify done,
-//     recorded by a FrameObserver into memory allocated before start.
+//     lockstep pacing as fast as it goes); the latency is from the frame's latency origin
+//     (hal::latency_origin_ns, the same start as the pipeline's statistics: the trigger
+//     of a live or simulated camera, a replay's delivery) to identify done, recorded by a
+//     FrameObserver + FrameTap into memory allocated before start.
 // Processor mode also reports the p99 of the thread's CPU time per frame, which the
 // preemption by other processes on a shared machine does not inflate.
 // RSS comes from /proc/self/statm, read between windows (processor mode) or once a
@@ -19,6 +21,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -175,16 +178,28 @@ int run_processor(const Args& a, const hal::SimFrameLoop& loop) {
   return 0;
 }
 
-// Pipeline mode: the observer stores each frame's trigger -> identify latency.
-class LatencyObserver final : public pipeline::FrameObserver {
+// Pipeline mode: each frame's latency from where the pipeline's own statistics start
+// (hal::latency_origin_ns of camera 0's frame: a live or simulated camera's trigger, a
+// replay's delivery; the published capture_ns may be a recording's time instead) to
+// identify done. The tap (capture thread) notes the origin per sequence number before
+// the frame goes to its detector; the observer (identify thread) reads it once that
+// frame's blobs arrived, so the rings between the stages order the two accesses
+// (relaxed atomics: no further ordering is needed, and TSan sees no plain race).
+class LatencyObserver final : public pipeline::FrameObserver, public pipeline::FrameTap {
  public:
-  explicit LatencyObserver(std::size_t n) : ns_(n, 0), found_(n, 0) {}
+  explicit LatencyObserver(std::size_t n) : origin_ns_(n), ns_(n, 0), found_(n, 0) {}
+  void on_frame(int camera, const hal::Frame& frame) noexcept override {
+    if (camera != 0 || frame.sequence >= origin_ns_.size()) return;
+    origin_ns_[frame.sequence].store(hal::latency_origin_ns(frame), std::memory_order_relaxed);
+  }
   void observe(std::uint64_t sequence, std::int64_t capture_ns,
                const FrameOutput& out) noexcept override {
     if (sequence >= ns_.size()) return;
-    ns_[sequence] = hal::monotonic_ns() - capture_ns;
+    const std::int64_t origin = origin_ns_[sequence].load(std::memory_order_relaxed);
+    ns_[sequence] = hal::monotonic_ns() - (origin != 0 ? origin : capture_ns);
     found_[sequence] = all_found(out) ? 1 : 0;
   }
+  std::vector<std::atomic<std::int64_t>> origin_ns_;  // by sequence; 0: not seen
   std::vector<std::int64_t> ns_;
   std::vector<std::uint8_t> found_;
 };
@@ -224,6 +239,7 @@ int run_pipeline(const Args& a, const std::shared_ptr<const hal::SimFrameLoop>& 
   opt.trigger_rate_hz = 5000.0;
   opt.max_frames = a.frames;
   opt.observer = &obs;
+  opt.tap = &obs;  // the latency origin of each frame, as the pipeline's statistics use it
   auto p = pipeline::Pipeline::create(std::move(proc).value(), {cams[0].get(), cams[1].get()},
                                       {&sink}, opt);
   if (!p) {

@@ -19,7 +19,7 @@
 namespace mocap::publish {
 
 // The compiled capacities of one frame's result (docs/formats.md, "Capacities", with their
-// memory: sizeof(FrameResult) is about 58 KiB). The builder (pipeline/
+// memory: sizeof(FrameResult) is 55.6 KiB). The builder (pipeline/
 // frame_result_builder.cpp) asserts that they hold everything the tracker produces.
 inline constexpr int kMaxResultBodies = 32;            // = identify's kMaxBodies
 inline constexpr int kMaxResultMarkers = 512;          // labelled markers per frame (32 x 16)

@@ -67,11 +67,12 @@ class ParameterSection {
     param(group, name, -1, {static_cast<int>(value.size())},
           std::vector<unsigned char>(value.begin(), value.end()), description);
   }
-  // Strings padded with blanks to the longest: dimensions (length, count).
+  // Strings padded with blanks to the longest: dimensions (length, count). A dimension is
+  // one byte, so at most 255 strings of at most 255 characters (checked by the caller).
   void text(int group, const std::string& name, const std::vector<std::string>& values,
             const std::string& description) {
-    std::size_t len = 1;  // a dimension is one byte: longer strings are cut at 255
-    for (const std::string& v : values) len = std::min<std::size_t>(255, std::max(len, v.size()));
+    std::size_t len = 1;
+    for (const std::string& v : values) len = std::max(len, v.size());
     std::vector<unsigned char> data;
     for (const std::string& v : values) {
       std::string padded = v;
@@ -81,12 +82,39 @@ class ParameterSection {
     param(group, name, -1, {static_cast<int>(len), static_cast<int>(values.size())}, data,
           description);
   }
+  // A list longer than one parameter holds (255 strings) continues in NAME2, NAME3, ...
+  // (the C3D convention of POINT:LABELS2 etc.): 255 strings per parameter, in order.
+  void text_list(int group, const std::string& name, const std::vector<std::string>& values,
+                 const std::string& description) {
+    for (std::size_t first = 0, part = 1; first < values.size();
+         first += kC3dLabelsPerParameter, ++part) {
+      const std::size_t end = std::min(values.size(), first + kC3dLabelsPerParameter);
+      text(group, part == 1 ? name : name + std::to_string(part),
+           std::vector<std::string>(values.begin() + static_cast<std::ptrdiff_t>(first),
+                                    values.begin() + static_cast<std::ptrdiff_t>(end)),
+           description);
+    }
+  }
+  // Closes the section (the last record keeps offset 0). The name of the first record
+  // longer than its 16-bit signed offset word can span, or empty.
+  const std::string& oversized() noexcept {
+    check_last();
+    return oversized_;
+  }
   const std::vector<unsigned char>& bytes() const noexcept { return bytes_; }
 
  private:
+  // The record that starts now ends the previous one: its offset word points here.
+  void check_last() {
+    if (last_offset_at_ != 0 && bytes_.size() - last_offset_at_ > kMaxRecordOffset &&
+        oversized_.empty())
+      oversized_ = last_name_;
+  }
   void begin(int id, const std::string& name) {
-    if (last_offset_at_ != 0)
+    check_last();
+    if (last_offset_at_ != 0 && oversized_.empty())
       set_i16(bytes_, last_offset_at_, static_cast<int>(bytes_.size() - last_offset_at_));
+    last_name_ = name;
     put_u8(bytes_, static_cast<int>(name.size()));
     put_u8(bytes_, id);
     bytes_.insert(bytes_.end(), name.begin(), name.end());
@@ -103,11 +131,15 @@ class ParameterSection {
     put_u8(bytes_, static_cast<int>(description.size()));
     bytes_.insert(bytes_.end(), description.begin(), description.end());
   }
+  static constexpr std::size_t kMaxRecordOffset = 32767;  // a signed 16-bit word
   std::vector<unsigned char> bytes_;
   std::size_t last_offset_at_ = 0;
+  std::string last_name_, oversized_;
 };
 
-std::vector<unsigned char> parameters(const TrajectoryLayout& l, int data_start_block) {
+// The parameter records; `oversized` names a record too long for its offset word.
+std::vector<unsigned char> parameters(const TrajectoryLayout& l, int data_start_block,
+                                      std::string& oversized) {
   const int used = static_cast<int>(l.labels.size());
   const auto last = static_cast<std::int64_t>(l.first_frame + l.frame_count - 1);
   const float rate = static_cast<float>(l.rate_hz);
@@ -120,10 +152,10 @@ std::vector<unsigned char> parameters(const TrajectoryLayout& l, int data_start_
   p.int16(kPoint, "DATA_START", {data_start_block}, false, "first block of the 3D data");
   p.int16(kPoint, "FRAMES", {static_cast<int>(l.frame_count)}, false, "number of frames");
   p.string(kPoint, "UNITS", "mm", "units of the coordinates");
-  p.text(kPoint, "LABELS", l.labels, "BODY_mN: marker N of body BODY (targets.yaml)");
-  p.text(kPoint, "DESCRIPTIONS",
-         l.descriptions.size() == l.labels.size() ? l.descriptions : l.labels,
-         "trajectory descriptions");
+  p.text_list(kPoint, "LABELS", l.labels, "BODY_mN: marker N of body BODY (targets.yaml)");
+  p.text_list(kPoint, "DESCRIPTIONS",
+              l.descriptions.size() == l.labels.size() ? l.descriptions : l.labels,
+              "trajectory descriptions");
   p.group(kAnalog, "ANALOG", "analog data parameters");
   p.int16(kAnalog, "USED", {0}, false, "no analog channels");
   p.real(kAnalog, "RATE", rate, "analog rate (no channels)");
@@ -136,19 +168,28 @@ std::vector<unsigned char> parameters(const TrajectoryLayout& l, int data_start_
           "last frame (low word, high word)");
   p.int16(kTrial, "CAMERA_RATE", {static_cast<int>(std::lround(l.rate_hz))}, false,
           "camera frames per second (rounded)");
+  oversized = p.oversized();
   return p.bytes();
 }
 
 }  // namespace
 
 Expected<std::vector<unsigned char>> c3d_header_and_parameters(const TrajectoryLayout& l) {
-  if (l.labels.empty() || l.labels.size() > 255) {
+  if (l.labels.empty() || l.labels.size() > static_cast<std::size_t>(kC3dMaxPoints)) {
     return make_error("C3D", "POINT:LABELS",
-                      "needs 1 to 255 trajectories, got " + std::to_string(l.labels.size()));
+                      "needs 1 to " + std::to_string(kC3dMaxPoints) + " trajectories, got " +
+                          std::to_string(l.labels.size()));
   }
   for (const std::string& s : l.labels) {
     if (s.empty() || s.size() > 255)
       return make_error("C3D", "POINT:LABELS", "label '" + s + "' must have 1 to 255 characters");
+  }
+  if (l.descriptions.size() == l.labels.size()) {  // else the labels are the descriptions
+    for (const std::string& s : l.descriptions) {
+      if (s.size() > 255)
+        return make_error("C3D", "POINT:DESCRIPTIONS",
+                          "description '" + s + "' has more than 255 characters");
+    }
   }
   if (!(l.rate_hz > 0.0) || !std::isfinite(l.rate_hz))
     return make_error("C3D", "POINT:RATE", "frame rate must be positive");
@@ -159,9 +200,21 @@ Expected<std::vector<unsigned char>> c3d_header_and_parameters(const TrajectoryL
                           " do not fit C3D's 16-bit frame numbers (1..65535); split the recording");
   }
   // The parameter size does not depend on DATA_START's value: build once to size it.
-  const std::size_t param_bytes = 4 + parameters(l, 0).size();
+  std::string oversized;
+  const std::size_t param_bytes = 4 + parameters(l, 0, oversized).size();
+  if (!oversized.empty()) {
+    const bool labels = oversized.rfind("LABELS", 0) == 0;
+    return make_error("C3D", "POINT:" + oversized,
+                      std::string("the ") + (labels ? "labels" : "descriptions") +
+                          " are too long for one parameter record (at most 32767 bytes: 255 "
+                          "texts of up to 128 characters); shorten the body names");
+  }
   const std::size_t param_blocks = (param_bytes + kBlock - 1) / kBlock;
-  if (param_blocks > 255) return make_error("C3D", "parameters", "parameter section too large");
+  if (param_blocks > 255) {
+    return make_error("C3D", "parameters",
+                      "the parameter section needs " + std::to_string(param_blocks) +
+                          " blocks, at most 255 fit (shorten the labels)");
+  }
   const int data_start = static_cast<int>(2 + param_blocks);
 
   std::vector<unsigned char> out(kBlock * (1 + param_blocks), 0);
@@ -182,7 +235,7 @@ Expected<std::vector<unsigned char>> c3d_header_and_parameters(const TrajectoryL
   out[kBlock + 1] = 0x50;
   out[kBlock + 2] = static_cast<unsigned char>(param_blocks);
   out[kBlock + 3] = kProcessorIntel;
-  const std::vector<unsigned char> params = parameters(l, data_start);
+  const std::vector<unsigned char> params = parameters(l, data_start, oversized);
   std::copy(params.begin(), params.end(), out.begin() + static_cast<std::ptrdiff_t>(kBlock + 4));
   return out;
 }

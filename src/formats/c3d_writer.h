@@ -5,11 +5,17 @@
 // X, Y, Z (mm) and the residual word. A valid sample's residual word is the integer
 // (camera mask << 8 | residual / |SCALE|, at least 1) stored as a float; a marker not
 // seen in a frame is invalid: X = Y = Z = 0 and residual word -1. No analog data.
-// Limits checked at open (one-line errors naming the file): 1..255 labels of at most 255
-// characters, and frame numbers up to 65535 (the header's 16-bit frame words and
-// POINT:FRAMES; see docs/formats.md).
+// Labels: POINT:LABELS holds the first 255 (a parameter dimension is one byte), the next
+// 255 go to POINT:LABELS2, then LABELS3, ... (the C3D convention for more than 255
+// points; DESCRIPTIONS likewise); POINT:USED (signed 16-bit) and header word 2 count all.
+// Limits checked at open (one-line errors naming the file; docs/formats.md, "C3D"):
+// 1..32767 labels (POINT:USED) of 1..255 characters, each parameter record within its
+// signed 16-bit offset (255 labels of up to 128 characters), the whole parameter section
+// within 255 blocks, and frame numbers up to 65535 (the header's 16-bit frame words and
+// POINT:FRAMES). The tracker writes at most 32 x 16 = 512 labels.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <utility>
@@ -23,6 +29,8 @@ namespace mocap {
 
 inline constexpr float kC3dPointScale = -0.1f;  // float data; residual unit 0.1 mm
 inline constexpr std::int64_t kC3dMaxFrame = 65535;
+inline constexpr int kC3dMaxPoints = 32767;                 // POINT:USED is a signed 16-bit word
+inline constexpr std::size_t kC3dLabelsPerParameter = 255;  // LABELS, LABELS2, ... each
 
 class C3dWriter {
  public:

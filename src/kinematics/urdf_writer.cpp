@@ -1,6 +1,7 @@
 // Design: see urdf_writer.h. Plain string building with %.17g numbers (exact round trip).
 #include "kinematics/urdf_writer.h"
 
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <numbers>
@@ -20,8 +21,9 @@ std::string g(double v) {
 std::string vec(const Vec3& v) { return g(v[0]) + " " + g(v[1]) + " " + g(v[2]); }
 
 // URDF rpy: R = Rz(yaw) * Ry(pitch) * Rx(roll) (fixed-axis roll, pitch, yaw), metres.
+// The pitch from atan2 (well conditioned also near +-90 deg, where asin is not).
 Vec3 rpy(const Mat3& R) {
-  const double pitch = std::asin(std::fmax(-1.0, std::fmin(1.0, -R(2, 0))));
+  const double pitch = std::atan2(-R(2, 0), std::hypot(R(0, 0), R(1, 0)));
   if (std::abs(R(2, 0)) > 1.0 - 1e-12) {
     return Vec3(std::atan2(-R(1, 2), R(1, 1)), pitch, 0.0);
   }

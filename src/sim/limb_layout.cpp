@@ -61,7 +61,6 @@ std::vector<Triangle> triangles_of(const std::vector<Vec3>& p) {
   return t;
 }
 
-
 // Distance from p to the segment a-b.
 double segment_distance(const Vec3& p, const Vec3& a, const Vec3& b) {
   const Vec3 ab = b - a;
@@ -75,7 +74,7 @@ bool ball_clears(const Vec3& c, const std::vector<LimbBody>& all, const LimbBody
   for (const LimbBody& b : all) {
     for (std::size_t i = 0; i < b.limbs.size(); ++i) {
       if (&b == &own && i == 0) continue;
-      const Limb& l = b.limbs[i];
+      const LimbCapsule& l = b.limbs[i];
       if (segment_distance(c, l.a, l.b) < l.radius_mm + rules.ball_radius_mm + rules.clearance_mm)
         return false;
     }
@@ -88,7 +87,7 @@ bool ball_clears(const Vec3& c, const std::vector<LimbBody>& all, const LimbBody
 Expected<std::vector<Mount>> search_layout(const std::vector<LimbBody>& all, const LimbBody& body,
                                            const LayoutRules& rules, Rng& rng,
                                            const std::vector<Triangle>& placed) {
-  const Limb& main = body.limbs[0];
+  const LimbCapsule& main = body.limbs[0];
   Vec3 d, front, side;
   limb_azimuth_frame(main.a, main.b, d, front, side);
   const double len = (main.b - main.a).norm();

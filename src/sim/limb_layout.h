@@ -19,7 +19,7 @@
 namespace mocap::sim {
 
 // A limb capsule in the world at the reference pose.
-struct Limb {
+struct LimbCapsule {
   Vec3 a, b;
   double radius_mm;
 };
@@ -30,7 +30,7 @@ struct Limb {
 struct LimbBody {
   const char* name;
   int parent;  // -1: the root
-  std::vector<Limb> limbs;
+  std::vector<LimbCapsule> limbs;
   int markers;
   double s_lo, s_hi;
   double phi_lo_deg, phi_hi_deg;

@@ -260,7 +260,7 @@ Expected<SimScene> build_humanoid_scene(const SceneOptions& options) {
 
   const std::vector<LimbBody> bodies = humanoid_bodies();
   for (const LimbBody& b : bodies) {
-    const Limb& main = b.limbs[0];
+    const LimbCapsule& main = b.limbs[0];
     scene.T_world_body_ref.push_back(
         make_iso(frame_rotation(b.frame_rot_deg), 0.5 * (main.a + main.b)));
     MarkerTarget t;
@@ -275,7 +275,8 @@ Expected<SimScene> build_humanoid_scene(const SceneOptions& options) {
     const int b = static_cast<int>(bi);
     // The forearms are polished tubes (the source of --streak's reflection).
     const bool shiny = std::string(bodies[bi].name).rfind("forearm", 0) == 0;
-    for (const Limb& l : bodies[bi].limbs) add_capsule(scene, b, l.a, l.b, l.radius_mm, shiny);
+    for (const LimbCapsule& l : bodies[bi].limbs)
+      add_capsule(scene, b, l.a, l.b, l.radius_mm, shiny);
     for (const Mount& m : (*layout)[bi]) add_marker(scene, b, m.center, m.post_root, kPostRadiusMm);
   }
   for (const JointDef& j : humanoid_joints()) {

@@ -11,12 +11,18 @@ tracks a short simulated recording with `mocap track` and checks that
   * the TRC file carries the same labels, rate, frame count and values (empty cells
     exactly where markers.csv has no row),
   * an unwritable or full export file is a one-line error naming that file.
+With --scene humanoid it tracks a few frames of the whole-body humanoid (71 markers) on
+3 cameras, its targets.yaml preceded by --extra-bodies bodies of 16 markers each that
+are never in view, so that there are more than 255 labels: the C3D then continues
+POINT:LABELS in POINT:LABELS2 (255 labels per parameter, the C3D convention for more than
+255 points; DESCRIPTIONS likewise) and the humanoid's tracked markers land there.
 Exits non-zero with a message on the first mismatch.
 """
 import argparse
 import csv
 import math
 import os
+import random
 import struct
 import subprocess
 import sys
@@ -114,13 +120,30 @@ def read_c3d(path):
     return hdr, named, samples
 
 
+def string_list(par, key):
+    """KEY, KEY2, KEY3, ... concatenated; each part holds at most 255 strings."""
+    out = list(par[key])
+    part = 2
+    while "%s%d" % (key, part) in par:
+        previous = par[key if part == 2 else "%s%d" % (key, part - 1)]
+        if len(previous) != 255:
+            fail("%s%d follows a part of %d strings (not 255)" % (key, part, len(previous)))
+        out += par["%s%d" % (key, part)]
+        part += 1
+    return out
+
+
 def check_c3d(path, markers, frames_csv, labels):
     hdr, par, samples = read_c3d(path)
     n = len(labels)
     if hdr["points"] != n or par["POINT:USED"] != n:
         fail("points %d / USED %d, expected %d" % (hdr["points"], par["POINT:USED"], n))
-    if par["POINT:LABELS"] != labels:
-        fail("labels %r, expected %r" % (par["POINT:LABELS"], labels))
+    if string_list(par, "POINT:LABELS") != labels:
+        fail("labels %r, expected %r" % (string_list(par, "POINT:LABELS"), labels))
+    if len(string_list(par, "POINT:DESCRIPTIONS")) != n:
+        fail("%d descriptions for %d labels" % (len(string_list(par, "POINT:DESCRIPTIONS")), n))
+    if (n > 255) != ("POINT:LABELS2" in par):
+        fail("%d labels but POINT:LABELS2 %s" % (n, "present" if n <= 255 else "missing"))
     if par["POINT:UNITS"] != "mm":
         fail("units %r" % par["POINT:UNITS"])
     if hdr["data_start"] != par["POINT:DATA_START"]:
@@ -208,54 +231,95 @@ def one_line_error(cmd, name):
         fail("expected a one-line error naming %s, got rc=%d stderr=%r" % (name, r.returncode, r.stderr))
 
 
+def write_targets_with_extra_bodies(src, dst, extra):
+    """targets.yaml of src preceded by `extra` bodies of 16 random markers (not in the scene)."""
+    with open(src) as f:
+        lines = f.read().split("\n")
+    at = lines.index("bodies:") + 1
+    added = []
+    for b in range(extra):
+        added += ["  - name: spare%02d" % b, "    markers:"]
+        rng = random.Random(1000 + b)  # an irregular shape of its own per body
+        pts = []
+        while len(pts) < 16:  # markers at least 30 mm apart (balls of 14 mm)
+            p = tuple(rng.uniform(-150.0, 150.0) for _ in range(3))
+            if all(math.dist(p, q) >= 30.0 for q in pts):
+                pts.append(p)
+        added += ["      - [%.3f, %.3f, %.3f]" % p for p in pts]
+    with open(dst, "w") as f:
+        f.write("\n".join(lines[:at] + added + lines[at:]))
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--mocap", required=True)
+    ap.add_argument("--scene", default="limbs")
+    ap.add_argument("--extra-bodies", type=int, default=0)
     args = ap.parse_args()
     with tempfile.TemporaryDirectory(prefix="mocap_exports_") as tmp:
         rec = os.path.join(tmp, "rec")
-        out = os.path.join(tmp, "out")
-        subprocess.run([args.mocap, "simulate", "--out", rec, "--frames", "40", "--dropout", "0.08",
-                        "--fps", "120", "--threads", "1"], check=True, capture_output=True, timeout=120)
-        c3d, trc = os.path.join(tmp, "labelled.c3d"), os.path.join(tmp, "labelled.trc")
-        track = [args.mocap, "track", rec, "--targets", os.path.join(rec, "targets.yaml"), "--out", out,
-                 "--quiet"]
-        subprocess.run(track + ["--c3d", c3d, "--trc", trc], check=True, timeout=120)
-        with open(os.path.join(rec, "frames.csv")) as f:
-            frames_csv = [(int(r["frame"]), int(r["timestamp_ns"])) for r in csv.DictReader(f)]
-        markers = {}
-        with open(os.path.join(out, "markers.csv")) as f:
-            for r in csv.DictReader(f):
-                label = "%s_m%s" % (r["body"], r["marker"])
-                markers[(int(r["frame"]), label)] = (float(r["x"]), float(r["y"]), float(r["z"]),
-                                                     float(r["residual_mm"]))
-        labels = []
-        body = None
-        with open(os.path.join(rec, "targets.yaml")) as f:  # names and marker counts, in order
-            count = {}
-            order = []
-            for line in f:
-                s = line.strip()
-                if s.startswith("- name:"):
-                    body = s.split(":", 1)[1].strip().strip("'\"")
-                    order.append(body)
-                    count[body] = 0
-                elif s.startswith("- [") and body is not None:
-                    count[body] += 1
-            for b in order:
-                labels += ["%s_m%d" % (b, m) for m in range(count[b])]
-        if len(markers) < 20:
-            fail("only %d labelled markers: the scene did not track" % len(markers))
-        invalid = check_c3d(c3d, markers, frames_csv, labels)
-        if invalid == 0:
-            fail("no invalid sample: the drop-outs did not test the invalid convention")
-        check_trc(trc, markers, frames_csv, labels)
-        one_line_error(track + ["--c3d", os.path.join(tmp, "no", "such", "dir.c3d")], "dir.c3d")
-        if os.path.exists("/dev/full"):
-            one_line_error(track + ["--trc", "/dev/full"], "/dev/full")
-            one_line_error(track + ["--c3d", "/dev/full"], "/dev/full")
+        if args.scene == "humanoid":  # few frames and cameras: CI runs this under ASan
+            sim = ["--scene", "humanoid", "--cameras", "3", "--frames", "3"]
+        else:
+            sim = ["--scene", args.scene, "--frames", "40", "--dropout", "0.08"]
+        subprocess.run([args.mocap, "simulate", "--out", rec, "--fps", "120", "--threads", "1"] + sim,
+                       check=True, capture_output=True, timeout=300)
+        runs = [os.path.join(rec, "targets.yaml")]
+        if args.extra_bodies > 0:  # the scene's own targets first, then behind the spares
+            runs.append(os.path.join(tmp, "targets_extra.yaml"))
+            write_targets_with_extra_bodies(runs[0], runs[1], args.extra_bodies)
+        for targets in runs:
+            check_run(args, rec, tmp, targets, extra=targets != runs[0])
+
+
+def check_run(args, rec, tmp, targets, extra):
+    out = os.path.join(tmp, "out")
+    c3d, trc = os.path.join(tmp, "labelled.c3d"), os.path.join(tmp, "labelled.trc")
+    track = [args.mocap, "track", rec, "--targets", targets, "--out", out, "--quiet"]
+    subprocess.run(track + ["--c3d", c3d, "--trc", trc], check=True, timeout=120)
+    with open(os.path.join(rec, "frames.csv")) as f:
+        frames_csv = [(int(r["frame"]), int(r["timestamp_ns"])) for r in csv.DictReader(f)]
+    markers = {}
+    with open(os.path.join(out, "markers.csv")) as f:
+        for r in csv.DictReader(f):
+            label = "%s_m%s" % (r["body"], r["marker"])
+            markers[(int(r["frame"]), label)] = (float(r["x"]), float(r["y"]), float(r["z"]),
+                                                 float(r["residual_mm"]))
+    labels = []
+    body = None
+    with open(targets) as f:  # names and marker counts, in order
+        count = {}
+        order = []
+        for line in f:
+            s = line.strip()
+            if s.startswith("- name:"):
+                body = s.split(":", 1)[1].strip().strip("'\"")
+                order.append(body)
+                count[body] = 0
+            elif s.startswith("- [") and body is not None:
+                count[body] += 1
+        for b in order:
+            labels += ["%s_m%d" % (b, m) for m in range(count[b])]
+    if len(markers) < 20:
+        fail("only %d labelled markers: the scene did not track" % len(markers))
+    if args.scene == "humanoid" and not extra and len(labels) != 71:
+        fail("the humanoid has %d labels, expected 71" % len(labels))
+    if extra and not any(labels.index(l) >= 255 for (_, l) in markers):
+        fail("no tracked marker has a label beyond the 255th: LABELS2 is not tested")
+    invalid = check_c3d(c3d, markers, frames_csv, labels)
+    if invalid == 0:
+        fail("no invalid sample: the drop-outs did not test the invalid convention")
+    check_trc(trc, markers, frames_csv, labels)
+    if extra:  # the write errors do not depend on the targets: checked once
         print("ok: %d labelled samples, %d invalid, %d labels, %d frames" % (len(markers), invalid,
                                                                                len(labels), len(frames_csv)))
+        return
+    one_line_error(track + ["--c3d", os.path.join(tmp, "no", "such", "dir.c3d")], "dir.c3d")
+    if os.path.exists("/dev/full"):
+        one_line_error(track + ["--trc", "/dev/full"], "/dev/full")
+        one_line_error(track + ["--c3d", "/dev/full"], "/dev/full")
+    print("ok: %d labelled samples, %d invalid, %d labels, %d frames" % (len(markers), invalid,
+                                                                           len(labels), len(frames_csv)))
 
 
 if __name__ == "__main__":

@@ -5,7 +5,8 @@
 // in a forked child with its own iceoryx runtime that exits before RouDi stops: RouDi
 // sends SIGTERM to every still-registered process when it shuts down. Skipped, with the
 // reason, when iox-roudi is not installed or another RouDi already runs on the machine.
-// ctest runs these under RESOURCE_LOCK iceoryx (RouDi's names are machine-global).
+// ctest runs these under RESOURCE_LOCK iceoryx (RouDi's names are machine-global). With
+// the pipeline and simulator built, also the whole-body humanoid's 14 joints.
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/wait.h>
@@ -22,6 +23,9 @@
 #include "pipeline/publish/output_registry.h"
 #include "tests/support/alloc_counter.h"
 #include "tests/support/test_support.h"
+#ifdef MOCAP_TEST_HUMANOID
+#include "tests/pipeline/humanoid_frame.h"
+#endif
 
 namespace {
 
@@ -211,6 +215,51 @@ void registry_body() {
 TEST_F(IceoryxRoundTrip, RegistryIceoryxSinkUsesSharedMemoryWhenRouDiRuns) {
   run_in_child(registry_body);
 }
+
+#ifdef MOCAP_TEST_HUMANOID
+// The whole-body humanoid's full frame (tests/pipeline/humanoid_frame.h): its 14 joint
+// records (8 ball, 6 hinge, the tracker's angles of the true model) arrive through shared
+// memory as published, record for record.
+void humanoid_body() {
+  std::vector<mocap::publish::OutputRequest> req = {
+      {"iceoryx", {"true"}, "test: outputs.iceoryx", {{"app_name", app_name()}}}};
+  auto outs = mocap::publish::create_outputs(req, {});
+  ASSERT_TRUE(outs.ok()) << outs.error().message;
+  ASSERT_EQ(outs->sinks.size(), 1u);
+  auto sub = mocap::client::IceoryxSubscriber::create(app_name());
+  ASSERT_TRUE(sub.ok());
+  auto& s = *sub.value();
+  for (int i = 0; i < 200 && !s.subscribed(); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(25));
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  ASSERT_TRUE(s.subscribed());
+  auto h = mocap::testing::make_humanoid_frame(3, 31);
+  const auto frame = h->make_result(123456);
+  ASSERT_EQ(frame->joints.joint_count, 14u);
+  ASSERT_TRUE(outs->sinks[0]->publish(*frame));
+  JointsMessage out;
+  ASSERT_TRUE(s.take_latest(out));
+  EXPECT_EQ(out.sequence, 7u);
+  EXPECT_EQ(out.capture_ns, 123456);
+  EXPECT_EQ(out.flags, frame->joints.flags);
+  ASSERT_EQ(out.joint_count, 14u);
+  int hinges = 0;
+  for (int j = 0; j < 14; ++j) {
+    const mocap::JointSpec& spec = h->scene.joints_true.joints[static_cast<std::size_t>(j)];
+    const mocap::kinematics::JointAngle& a = h->out->angles.joints[static_cast<std::size_t>(j)];
+    hinges += out.joints[j].type == 1;
+    EXPECT_EQ(out.joints[j].index, j);
+    EXPECT_EQ(out.joints[j].type, spec.type == mocap::JointType::kHinge ? 1 : 0) << spec.name;
+    EXPECT_EQ(out.joints[j].valid, 1) << spec.name;
+    EXPECT_FLOAT_EQ(out.joints[j].a[0], static_cast<float>(a.a0)) << spec.name;
+    EXPECT_FLOAT_EQ(out.joints[j].a[2], static_cast<float>(a.a2)) << spec.name;
+    EXPECT_EQ(out.quality[j].solved_by, frame->joints.quality[j].solved_by);
+  }
+  EXPECT_EQ(hinges, 6);
+}
+
+TEST_F(IceoryxRoundTrip, HumanoidFrameArrivesWithEveryJoint) { run_in_child(humanoid_body); }
+#endif
 
 TEST(IceoryxNoRouDi, FailsFastAtAPathNobodyBinds) {
   mocap::test::TempDir dir("no_roudi");

@@ -134,7 +134,7 @@ TEST(C3dWriter, LimitsAreOneLineErrorsNamingTheFile) {
   ASSERT_FALSE(empty.ok());
   EXPECT_NE(empty.error().message.find("POINT:LABELS"), std::string::npos);
   TrajectoryLayout many = layout(10);
-  many.labels.assign(256, "x");
+  many.labels.assign(32768, "x");  // POINT:USED is signed 16-bit (more than 255: LABELS2...)
   EXPECT_FALSE(C3dWriter::open(path, many).ok());
   auto dir = C3dWriter::open("/nonexistent_dir/x.c3d", layout(10));
   ASSERT_FALSE(dir.ok());
