@@ -8,8 +8,8 @@
 //  3. Placement of a track (the cluster's other tracks, then every long track left
 //     over, the fragments of occluded markers included): its positions mapped into the
 //     body frame must agree (RMS <= body_fit_tolerance_mm, <= 5 % beyond 4x) over at
-//     least min_placement_frames posed frames, and the agreement must mean something
-//     (the body turned by min_pair_rotation_deg over those frames, or stayed still with
+//     least min_placement_frames() posed frames, and the agreement must mean something
+//     (the body turned by min_body_turn_rad(lever) over those frames, or stayed still with
 //     the point while the scene moved). The point then joins the marker within
 //     marker_diameter/4 that it never coexists with (a re-linked fragment), or becomes
 //     a new marker when farther than one marker diameter from all; anything in between,

@@ -91,6 +91,20 @@ struct Builder {
     return a * kDegPerRad;
   }
 
+  // The lever of a body-frame position for the turn test: its distance from the markers'
+  // centroid, at least the markers' RMS radius (the extent over which the body's
+  // orientation is measured).
+  double lever_mm(const Vec3& p_body) const {
+    const auto& m = body.markers_body;
+    if (m.empty()) return 1e-9;
+    Vec3 c = Vec3::Zero();
+    for (const Vec3& x : m) c += x;
+    c /= static_cast<double>(m.size());
+    double r2 = 0.0;
+    for (const Vec3& x : m) r2 += (x - c).squaredNorm();
+    return std::max((p_body - c).norm(), std::sqrt(r2 / static_cast<double>(m.size())));
+  }
+
   // Body-frame position of track ti when it fits rigidly and informatively.
   bool fits(int ti, Vec3& mean_body) const {
     const PointTrack& t = tracks[static_cast<std::size_t>(ti)];
@@ -101,7 +115,7 @@ struct Builder {
       fs.push_back(f);
       y.push_back(body.T_world_body[static_cast<std::size_t>(f)].inverse() * t.at(f));
     }
-    if (static_cast<int>(fs.size()) < opt.min_placement_frames) return false;
+    if (static_cast<int>(fs.size()) < opt.min_placement_frames()) return false;
     mean_body = Vec3::Zero();
     for (const Vec3& v : y) mean_body += v;
     mean_body /= static_cast<double>(y.size());
@@ -116,7 +130,8 @@ struct Builder {
     if (std::sqrt(sum2 / static_cast<double>(y.size())) > tol ||
         far * 20 > static_cast<int>(y.size()))
       return false;
-    if (rotation_range_deg(fs) >= opt.min_pair_rotation_deg) return true;
+    if (rotation_range_deg(fs) / kDegPerRad >= opt.min_body_turn_rad(lever_mm(mean_body)))
+      return true;
     // A still body: informative only when the point and the body stayed put while the scene moved.
     int moving_frames = 0;
     double spread = 0.0;
@@ -126,7 +141,7 @@ struct Builder {
       spread = std::max(spread, (t.at(f) - p0).norm());
     }
     return 2 * moving_frames >= static_cast<int>(fs.size()) &&
-           2 * moving_frames >= opt.min_placement_frames && spread <= opt.static_tolerance_mm;
+           moving_frames >= opt.min_placement_frames() && spread <= opt.static_tolerance_mm;
   }
 
   bool overlaps_marker(int ti, int marker) const {

@@ -50,9 +50,10 @@ std::pair<int, double> nearest_marker(const std::vector<Vec3>& markers, const Ve
 // The same body built twice from clusters of different time windows (occlusions cut
 // every track between them): B is A when A's target, identified among B's tracks (and
 // B's among A's), keeps one constant pose relative to B (rotation within 1 deg,
-// translation within 2 mm: kSameRotationDeg, kSameTranslationMm) over at least min_covisible_frames
-// frames in which A turned by min_pair_rotation_deg. B's markers then join A's (or are left to the
-// pool). Pose-based test (above); returns false when it cannot decide or says no.
+// translation within 2 mm: kSameRotationDeg, kSameTranslationMm) over at least
+// min_covisible_frames() frames in which A turned by min_body_turn_rad(A's radius). B's markers
+// then join A's (or are left to the pool). Pose-based test (above); returns false when it cannot
+// decide or says no.
 bool same_by_poses(const Builder& A, const Builder& B, Iso3& T_ab) {
   Builder a = A, b = B;
   a.extend_poses(B.members);
@@ -60,8 +61,9 @@ bool same_by_poses(const Builder& A, const Builder& B, Iso3& T_ab) {
   std::vector<int> fs;
   for (std::size_t f = 0; f < a.frames(); ++f)
     if (a.body.found[f] && b.body.found[f]) fs.push_back(static_cast<int>(f));
-  if (static_cast<int>(fs.size()) < A.opt.min_covisible_frames) return false;
-  if (a.rotation_range_deg(fs) < A.opt.min_pair_rotation_deg) return false;
+  if (static_cast<int>(fs.size()) < A.opt.min_covisible_frames()) return false;
+  if (a.rotation_range_deg(fs) / kDegPerRad < A.opt.min_body_turn_rad(a.lever_mm(Vec3::Zero())))
+    return false;
   const std::vector<Iso3> rel = relative_poses(a.body, b.body);
   T_ab = rel[rel.size() / 2];
   return all_within(rel, T_ab);
@@ -121,14 +123,14 @@ bool same_by_shape(const Builder& A, const Builder& B, Iso3& T_ab) {
 }
 
 // Coincidence test (bodies posed together, e.g. a still torso whose tracks were cut
-// into fragments by the arm passing in front of it): over at least min_covisible_frames
+// into fragments by the arm passing in front of it): over at least min_covisible_frames()
 // frames where both are posed, their relative pose is constant (1 deg, 2 mm), and at
 // least 2 markers of B then lie on distinct markers of A (within 4 fit tolerances), none
 // half-way (within one marker diameter but not on a marker). Two distinct bodies cannot
 // hold markers at the same place at the same time, so this needs no motion.
 bool same_by_coincidence(const Builder& A, const Builder& B, Iso3& T_ab) {
   const std::vector<Iso3> rel = relative_poses(A.body, B.body);
-  if (static_cast<int>(rel.size()) < A.opt.min_covisible_frames) return false;
+  if (static_cast<int>(rel.size()) < A.opt.min_covisible_frames()) return false;
   T_ab = rel[rel.size() / 2];
   if (!all_within(rel, T_ab)) return false;
   const double tol = 4.0 * A.opt.body_fit_tolerance_mm();

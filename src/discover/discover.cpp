@@ -6,6 +6,7 @@
 #include <optional>
 
 #include "discover/body_builder.h"
+#include "discover/body_union.h"
 #include "discover/point_tracker.h"
 #include "discover/rigid_groups.h"
 #include "discover/topology.h"
@@ -85,6 +86,8 @@ Expected<DiscoverResult> discover_model(const PointSequence& seq, const Discover
   const std::vector<PointTrack> tracks = std::move(points.tracks);
   opt.point_noise_mm = points.point_noise_mm;  // the later steps' noise
   st.point_noise_mm = opt.point_noise_mm;
+  st.min_covisible_frames = opt.min_covisible_frames();
+  st.min_placement_frames = opt.min_placement_frames();
   st.tracks = static_cast<int>(tracks.size());
   for (const PointTrack& t : tracks) st.long_tracks += t.seen >= opt.min_track_frames ? 1 : 0;
   const std::vector<char> moving = scene_motion(seq, tracks, opt);
@@ -111,8 +114,11 @@ Expected<DiscoverResult> discover_model(const PointSequence& seq, const Discover
         label + ": one rigid body only (" + std::to_string(built.bodies[0].markers_body.size()) +
         " markers): no joint to discover; move the robot's joints, not the robot as a whole"};
 
+  // The tracker's poses of the bodies' targets (replacing the discovery poses).
   std::optional<kinematics::CalibrationInput> tracked;
-  if (pose_source) {
+  auto track_bodies = [&]() {
+    tracked.reset();
+    if (!pose_source) return;
     TargetSet provisional;
     provisional.marker_diameter_mm = opt.marker_diameter_mm;
     for (std::size_t b = 0; b < built.bodies.size(); ++b)
@@ -133,10 +139,21 @@ Expected<DiscoverResult> discover_model(const PointSequence& seq, const Discover
                                : in.error().message) +
                            "); joints are estimated on the discovery poses");
     }
-  }
+  };
+  track_bodies();
   st.seconds_tracker = seconds_since(t0);
 
-  const TopologyResult topo = infer_topology(built.bodies, opt);
+  TopologyResult topo = infer_topology(built.bodies, opt);
+  // One body built as two: children of one parent at one joint centre that move as one
+  // (body_union.h) are merged, then tracked and joined again.
+  for (int round = 0; round < 2; ++round) {
+    const auto split = find_split_bodies(built.bodies, topo, opt);
+    if (split.empty()) break;
+    st.merged_bodies += static_cast<int>(split.size());
+    built.bodies = merge_bodies(std::move(built.bodies), split, opt);
+    track_bodies();
+    topo = infer_topology(built.bodies, opt);
+  }
   st.seconds_topology = seconds_since(t0);
 
   // Output order and names.

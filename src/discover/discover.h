@@ -3,7 +3,8 @@
 // point_tracker.h (point noise, short-term tracks) -> rigid_groups.h (rigid clusters)
 // -> body_builder.h (targets, poses) -> the tracker's poses of those targets (a
 // PoseSource, src/track, as `mocap calibrate` tracks) -> topology.h (joint tree and
-// types) -> src/kinematics calibrate_joints (Eq. 2 / rank-5 + Ceres refinement, exactly
+// types; body_union.h merges one body built as two, then tracks and joins again) ->
+// src/kinematics calibrate_joints (Eq. 2 / rank-5 + Ceres refinement, exactly
 // as `mocap calibrate`). Bad recordings (too few frames, nothing moving, no body or a
 // single body) are one-line errors prefixed by the recording's name; doubts are
 // warnings (unplaced tracks, symmetric targets, too little motion), never guesses.
@@ -30,6 +31,9 @@ struct DiscoverStats {
   int clusters = 0;
   double point_noise_mm = 0.0;  // used (stated, or estimated from the tracks)
   int unplaced_tracks = 0;
+  int merged_bodies = 0;  // bodies built as two, merged at their shared joint (body_union.h)
+  // The derived frame counts of the rigidity tests (discover_types.h) for the noise used.
+  int min_covisible_frames = 0, min_placement_frames = 0;
   double seconds_tracking = 0.0, seconds_grouping = 0.0, seconds_bodies = 0.0,
          seconds_tracker = 0.0, seconds_topology = 0.0, seconds_calibration = 0.0;
 };

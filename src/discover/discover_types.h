@@ -5,6 +5,7 @@
 // tolerances are derived. Offline, set-up style code: plain vectors, no hot path.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <string>
@@ -59,11 +60,8 @@ struct DiscoverOptions {
   // Tracking.
   int max_gap_frames = 1;    // a track coasts over this many missed frames
   double gate_sigmas = 4.0;  // noise part of every gate, in sigmas
-  // Grouping.
+  // Grouping (the frame counts and turns of the rigidity tests: derived, below).
   int min_track_frames = 10;               // shorter tracks are ignored (ghosts, glints)
-  int min_covisible_frames = 15;           // a pair test needs this many common frames
-  int min_placement_frames = 12;           // a track joins a body over this many posed frames
-  double min_pair_rotation_deg = 10.0;     // the pair's direction must turn this much
   double static_tolerance_mm = 1.0;        // a point moving less is static
   double min_scene_speed_mm_per_s = 20.0;  // a point moving faster makes the scene "moving"
   int max_pair_frames = 400;               // pair statistics on at most this many frames
@@ -82,6 +80,43 @@ struct DiscoverOptions {
     return 3.0 * std::sqrt(2.0) * sigma_mm() + model_error_mm;
   }
   double body_fit_tolerance_mm() const noexcept { return 4.0 * sigma_mm() + 0.2; }
+
+  // Frame counts and motion of the rigidity tests, derived from the noise (see
+  // docs/discover.md, "Frame counts and motion"; never tried on our scenes). A verdict
+  // "rigid" needs n samples such that the statistic of a truly rigid pair (or point)
+  // stays below its bound at z = 3 standard errors, the robust std of n Gaussian
+  // samples having a relative standard error of kMadRelativeError / sqrt(n) (the MAD's
+  // 37 % efficiency), and never fewer than kMinSamples (a median of 5 outvotes 2 bad
+  // frames); and the frames must cover enough motion to tell rigid from non-rigid.
+  static constexpr double kMadRelativeError = 1.17;
+  static constexpr int kMinSamples = 5;
+  static int frames_for(double noise_mm, double bound_mm) noexcept {
+    if (!(bound_mm > noise_mm)) return 1000000;  // the bound cannot be met: no verdict
+    const double root = 3.0 * kMadRelativeError * noise_mm / (bound_mm - noise_mm);
+    return std::max(kMinSamples, static_cast<int>(std::ceil(root * root)));
+  }
+  // A pair's distance (noise sqrt(2) sigma) against pair_distance_std_mm().
+  int min_covisible_frames() const noexcept {
+    return frames_for(std::sqrt(2.0) * sigma_mm(), pair_distance_std_mm());
+  }
+  // A point mapped into a body frame (3D residual sqrt(3) sigma) against the fit tolerance.
+  int min_placement_frames() const noexcept {
+    return frames_for(std::sqrt(3.0) * sigma_mm(), body_fit_tolerance_mm());
+  }
+  // The smallest turn (rad) of a pair of length `length_mm` that makes its rigid verdict
+  // mean something: had the two points been on bodies moving relatively by that much, the
+  // distance would sweep +-length*turn/2 and more than 20 % of the frames would deviate
+  // by more than 4 b (the non-rigid rule) once length*turn > 10 b.
+  double min_pair_turn_rad(double length_mm) const noexcept {
+    return 10.0 * pair_distance_std_mm() / std::max(length_mm, 1e-9);
+  }
+  // The smallest turn (rad) of a body that makes a point's fit at lever `lever_mm` from
+  // the markers' centroid mean something: a point not carried by the body would sweep
+  // +-lever*turn/2 in the body frame, an RMS of lever*turn/sqrt(12), beyond the fit
+  // tolerance once lever*turn > sqrt(12) tol.
+  double min_body_turn_rad(double lever_mm) const noexcept {
+    return std::sqrt(12.0) * body_fit_tolerance_mm() / std::max(lever_mm, 1e-9);
+  }
 };
 
 }  // namespace mocap::discover

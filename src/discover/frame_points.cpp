@@ -26,8 +26,6 @@ Expected<PointSequence> triangulate_recording(const std::string& recording_dir,
   FrameOutput out = proc->make_output();
   const std::size_t n_cams = rig.cameras.size();
 
-  constexpr std::uint32_t kSuspect = detect::kBlobTouchesBorder | detect::kBlobMerged |
-                                     detect::kBlobSplit | detect::kBlobTruncated;
   PointSequence seq;
   std::optional<Error> first_error;
   std::size_t usable_frames = 0;
@@ -62,15 +60,12 @@ Expected<PointSequence> triangulate_recording(const std::string& recording_dir,
     if (present >= static_cast<std::size_t>(kMinCameras)) {  // two cameras triangulate
       ++usable_frames;
       proc->process(std::span<const ImageView* const>(views.data(), n_cams), fe.timestamp_ns, out);
-      for (const Point3& p : out.points) {
-        bool keep = !p.ambiguous;
-        for (std::size_t c = 0; c < n_cams && keep; ++c) {
-          const int b = p.blob_index[c];
-          if (b < 0) continue;  // a camera that did not see the point
-          const detect::BlobList& blobs = out.blobs[c];
-          keep = static_cast<std::size_t>(b) < blobs.size() &&
-                 (blobs[static_cast<std::size_t>(b)].flags & kSuspect) == 0U;
-        }
+      for (int i = 0; i < out.points.size(); ++i) {
+        const Point3& p = out.points[i];
+        // Whole-marker views only: with three or more cameras the tracker has already
+        // refitted a point from its whole views when two or more remain (a flagged or
+        // misshapen view left out); otherwise the point is partial and left out here.
+        const bool keep = !p.ambiguous && !proc->point_partial(i);
         if (keep)
           fp.X_world_mm.push_back(p.X_world);
         else

@@ -5,8 +5,10 @@
 // nothing is identified. A frame in which a camera is missing still gives the points of
 // the others when two or more remain (a stereo pair: none). Only points that can be trusted as one
 // whole marker are kept: candidates that share a blob with another (epipolar ambiguity) and points
-// from blobs flagged merged, split, truncated or touching the border are left out (counted), so
-// that the rigidity tests see unbiased points.
+// the tracker marks partial (a view not a whole marker: flagged merged, split, truncated or at the
+// border, or misshapen, track/marker_shape.h, with fewer than two whole views left; with two or
+// more the tracker refits the point from them) are left out (counted), so that the rigidity tests
+// see unbiased points.
 #pragma once
 
 #include <cstdint>

@@ -86,18 +86,18 @@ PairRelation classify_pair(const PointTrack& a, const PointTrack& b,
                                                        [&](double x) { return x > 4.0 * bound; })) /
                      static_cast<double>(dev.size());
   if (robust_std > 2.0 * bound || far > 0.2) return PairRelation::kNonRigid;
-  if (n_all < opt.min_covisible_frames || robust_std > bound || far > 0.05)
+  if (n_all < opt.min_covisible_frames() || robust_std > bound || far > 0.05)
     return PairRelation::kUnknown;
   std::size_t i1 = 0;
   max_angle_deg(dirs, dirs[0], &i1);
   const double turned = max_angle_deg(dirs, dirs[i1], nullptr);
-  if (turned >= opt.min_pair_rotation_deg) return PairRelation::kRigid;
+  if (turned / kDegPerRad >= opt.min_pair_turn_rad(med)) return PairRelation::kRigid;
   const int moving_frames =
       static_cast<int>(std::count_if(frames.begin(), frames.end(), [&](int f) {
         return moving[static_cast<std::size_t>(f)] != 0;
       }));
   if (2 * moving_frames >= static_cast<int>(frames.size()) &&
-      moving_frames * 2 >= opt.min_covisible_frames &&
+      moving_frames >= opt.min_covisible_frames() &&
       spread_mm(a, frames) <= opt.static_tolerance_mm &&
       spread_mm(b, frames) <= opt.static_tolerance_mm)
     return PairRelation::kRigid;

@@ -4,10 +4,12 @@
 //  - non-rigid: the robust std of the distance (1.4826 * MAD) exceeds 2 b, or more than
 //    20 % of the frames deviate from the median by more than 4 b (b =
 //    pair_distance_std_mm(), 3 sqrt(2) point sigmas), with at least 5 common frames;
-//  - rigid: at least min_covisible_frames common frames, robust std <= b, at most 5 %
+//  - rigid: at least min_covisible_frames() common frames, robust std <= b, at most 5 %
 //    deviating frames, AND the test meant something: the pair's direction turned by at
-//    least min_pair_rotation_deg, or both points stayed put (static_tolerance_mm) while
-//    the scene moved in at least half of the common frames (a still torso);
+//    least min_pair_turn_rad(its length) (10 b / length: enough for a non-rigid pair to
+//    fail the 20 % rule), or both points stayed put (static_tolerance_mm) while the scene
+//    moved in at least half of the common frames, and in at least min_covisible_frames()
+//    (a still torso); both derived from the noise (discover_types.h);
 //  - unknown otherwise (too few frames, too little motion, in between).
 // Clusters grow by agglomeration over the rigid pairs (most common frames first):
 // clusters X and Y merge only when no pair between them is non-rigid and at least

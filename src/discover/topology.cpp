@@ -43,9 +43,12 @@ bool score_pair(const DiscoveredBody& A, const DiscoveredBody& B, int a, int b,
       hinge->diagnostics.residual_rms_mm <= 2.0 * d.residual_rms_mm + 0.1) {
     edge.type = JointType::kHinge;
     edge.diagnostics = hinge->diagnostics;
+    edge.center_parent = hinge->center_parent;
+    edge.axis_parent = hinge->axis_parent;
   } else if (s6 >= opt.linear.min_motion_deg) {
     edge.type = JointType::kBall;
     edge.diagnostics = d;
+    edge.center_parent = ball->center_parent;
   } else {
     low_motion = true;  // neither a clean hinge nor enough motion for a ball
     return false;
@@ -55,6 +58,12 @@ bool score_pair(const DiscoveredBody& A, const DiscoveredBody& B, int a, int b,
 }
 
 }  // namespace
+
+bool joint_candidate(const DiscoveredBody& P, const DiscoveredBody& C, const DiscoverOptions& opt,
+                     JointEdge& edge) {
+  bool low = false;
+  return score_pair(P, C, 0, 1, opt, edge, low);
+}
 
 TopologyResult infer_topology(const std::vector<DiscoveredBody>& bodies,
                               const DiscoverOptions& opt) {

@@ -26,7 +26,9 @@ struct JointEdge {
   int parent = 0;  // indices into the discovered bodies
   int child = 0;
   JointType type = JointType::kBall;
-  double residual_mm = 0.0;  // linear fit residual (rms, per pose)
+  double residual_mm = 0.0;           // linear fit residual (rms, per pose)
+  Vec3 center_parent = Vec3::Zero();  // the linear estimate's centre (hinge: a point on the axis)
+  Vec3 axis_parent = Vec3::UnitZ();   // hinge axis (unit), parent frame
   kinematics::LinearDiagnostics diagnostics;
 };
 
@@ -36,6 +38,11 @@ struct TopologyResult {
   std::vector<std::string> notes;
   std::vector<std::pair<int, int>> low_motion_pairs;  // (a, b) with too little motion
 };
+
+// The joint candidate between parent P and child C (the test above); false when the pair
+// is none (too few common frames, too little motion, residual too large).
+bool joint_candidate(const DiscoveredBody& P, const DiscoveredBody& C,
+                     const DiscoverOptions& options, JointEdge& edge);
 
 TopologyResult infer_topology(const std::vector<DiscoveredBody>& bodies,
                               const DiscoverOptions& options);

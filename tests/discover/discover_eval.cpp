@@ -7,6 +7,7 @@
 
 #include "discover/frame_points.h"
 #include "discover/point_tracker.h"
+#include "discover/rigid_groups.h"
 #include "discover_truth.h"
 
 int main(int argc, char** argv) {
@@ -31,10 +32,18 @@ int main(int argc, char** argv) {
                          static_cast<long long>(points->frames[static_cast<std::size_t>(f)].frame),
                          tracks[k].at(f).x(), tracks[k].at(f).y(), tracks[k].at(f).z());
       std::fclose(out);
+      if (const char* groups = std::getenv("DISCOVER_DUMP_GROUPS")) {  // rigid clusters
+        opt.point_noise_mm = mocap::discover::point_tracks(*points, opt).point_noise_mm;
+        const auto moving = mocap::discover::scene_motion(*points, tracks, opt);
+        FILE* g = std::fopen(groups, "w");
+        for (const auto& group : mocap::discover::group_rigid_tracks(tracks, moving, opt)) {
+          for (int ti : group) std::fprintf(g, "%d ", ti);
+          std::fprintf(g, "\n");
+        }
+        std::fclose(g);
+      }
     }
     mocap::discover::DiscoverOptions opt;
-    if (const char* v = std::getenv("MINCOV")) opt.min_covisible_frames = std::atoi(v);
-    if (const char* v = std::getenv("MINPLACE")) opt.min_placement_frames = std::atoi(v);
     auto r = mocap::discover::discover_model(*points, opt, rec,
                                              std::getenv("NO_TRACKER_CAL") == nullptr
                                                  ? mocap::discover::tracker_poses(rec)
@@ -51,11 +60,16 @@ int main(int argc, char** argv) {
       ++bad;
       continue;
     }
-    std::printf("%s: %zu bodies, %zu joints, %d unplaced tracks, %.2f s: %s\n", rec.c_str(),
-                r->targets.bodies.size(), r->model.joints.size(), r->stats.unplaced_tracks, s,
-                t->describe().c_str());
-    if (std::getenv("DISCOVER_VERBOSE") != nullptr)
+    std::printf(
+        "%s: %zu bodies (%d merged), %zu joints, %d unplaced tracks, noise %.3f mm, "
+        "frames >= %d / %d, %.2f s: %s\n",
+        rec.c_str(), r->targets.bodies.size(), r->stats.merged_bodies, r->model.joints.size(),
+        r->stats.unplaced_tracks, r->stats.point_noise_mm, r->stats.min_covisible_frames,
+        r->stats.min_placement_frames, s, t->describe().c_str());
+    if (std::getenv("DISCOVER_VERBOSE") != nullptr) {
       for (const std::string& line : t->body_lines) std::printf("  %s\n", line.c_str());
+      for (const std::string& line : t->joint_lines) std::printf("  %s\n", line.c_str());
+    }
   }
   return bad == 0 ? 0 : 1;
 }

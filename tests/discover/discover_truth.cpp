@@ -16,13 +16,14 @@ double median(std::vector<double> v) { return v.empty() ? 1e9 : median_in_place(
 }  // namespace
 
 std::string DiscoverTruth::describe() const {
-  char buf[320];
+  char buf[400];
   std::snprintf(buf, sizeof buf,
-                "true bodies %d, complete %d, wrong markers %d, unmatched markers %d, topology %s, "
-                "ball centre %.3f mm, hinge axis %.3f deg, hinge line %.3f mm",
-                true_bodies, bodies_complete, wrong_markers, unmatched_markers,
-                topology_ok ? "ok" : "WRONG", worst_ball_center_mm, worst_hinge_axis_deg,
-                worst_hinge_line_mm);
+                "true bodies %d, complete %d, wrong markers %d, unmatched markers %d, joints "
+                "right %d / %d (%d wrong), topology %s, ball centre %.3f mm, hinge axis %.3f deg, "
+                "hinge line %.3f mm",
+                true_bodies, bodies_complete, wrong_markers, unmatched_markers, joints_right,
+                true_joints, joints_wrong, topology_ok ? "ok" : "WRONG", worst_ball_center_mm,
+                worst_hinge_axis_deg, worst_hinge_line_mm);
   return buf;
 }
 
@@ -128,16 +129,25 @@ Expected<DiscoverTruth> compare_with_truth(const std::string& rec,
   }
   // Topology and joint parameters.
   out.topology_ok = r.model.joints.size() == model->joints.size();
+  out.true_joints = static_cast<int>(model->joints.size());
+  std::vector<char> matched(r.model.joints.size(), 0);
   for (const JointSpec& tj : model->joints) {
     const JointSpec* dj = nullptr;
-    for (const JointSpec& j : r.model.joints)
+    for (std::size_t k = 0; k < r.model.joints.size(); ++k) {
+      const JointSpec& j = r.model.joints[k];
       if (out.body_map[static_cast<std::size_t>(j.parent_index)] == tj.parent_index &&
-          out.body_map[static_cast<std::size_t>(j.child_index)] == tj.child_index)
+          out.body_map[static_cast<std::size_t>(j.child_index)] == tj.child_index &&
+          j.type == tj.type) {
         dj = &j;
-    if (dj == nullptr || dj->type != tj.type) {
+        matched[k] = 1;
+      }
+    }
+    if (dj == nullptr) {
       out.topology_ok = false;
+      out.joint_lines.push_back(tj.name + ": not found");
       continue;
     }
+    ++out.joints_right;
     std::vector<double> centre, axis, line;
     for (std::size_t f = 0; f < frames; ++f) {
       const auto& obs = r.input.frames[f].bodies[static_cast<std::size_t>(dj->parent_index)];
@@ -156,12 +166,30 @@ Expected<DiscoverTruth> compare_with_truth(const std::string& rec,
         line.push_back((v - v.dot(a_true) * a_true).norm());
       }
     }
-    if (tj.type == JointType::kBall)
+    char buf[160];
+    if (tj.type == JointType::kBall) {
       out.worst_ball_center_mm = std::max(out.worst_ball_center_mm, median(centre));
-    else {
+      std::snprintf(buf, sizeof buf, "%s: %s, ball centre %.3f mm", tj.name.c_str(),
+                    dj->name.c_str(), median(centre));
+    } else {
       out.worst_hinge_axis_deg = std::max(out.worst_hinge_axis_deg, median(axis));
       out.worst_hinge_line_mm = std::max(out.worst_hinge_line_mm, median(line));
+      std::snprintf(buf, sizeof buf, "%s: %s, hinge axis %.3f deg, line %.3f mm", tj.name.c_str(),
+                    dj->name.c_str(), median(axis), median(line));
     }
+    out.joint_lines.push_back(buf);
+  }
+  for (std::size_t k = 0; k < r.model.joints.size(); ++k) {
+    if (matched[k]) continue;
+    ++out.joints_wrong;
+    const JointSpec& j = r.model.joints[k];
+    auto name = [&](int d) {
+      const int t = out.body_map[static_cast<std::size_t>(d)];
+      return t < 0 ? std::string("?") : targets->bodies[static_cast<std::size_t>(t)].name;
+    };
+    out.joint_lines.push_back("wrong joint " + j.name + " (" +
+                              (j.type == JointType::kBall ? "ball" : "hinge") +
+                              "): " + name(j.parent_index) + " -> " + name(j.child_index));
   }
   return out;
 }

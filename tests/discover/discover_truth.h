@@ -8,6 +8,7 @@
 // axis direction (up to sign).
 #pragma once
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -24,9 +25,16 @@ struct DiscoverTruth {
   std::vector<int> body_map;            // discovered body -> true body index (-1: none)
   std::vector<std::string> body_lines;  // per discovered body: its markers' true labels
   bool topology_ok = false;             // same joints (parent, child, type) as the true model
-  double worst_ball_center_mm = 0.0;    // median over frames, worst joint
+  int true_joints = 0;
+  int joints_right = 0;                  // true joints found with their parent, child and type
+  int joints_wrong = 0;                  // discovered joints that are no true joint (or wrong type)
+  std::vector<std::string> joint_lines;  // per true joint: found as what, its errors
+  double worst_ball_center_mm = 0.0;     // median over frames, worst joint
   double worst_hinge_axis_deg = 0.0;
   double worst_hinge_line_mm = 0.0;  // distance of the hinge point from the true axis line
+  double worst_centre_mm() const {   // the joint centre: ball centre or hinge line
+    return std::max(worst_ball_center_mm, worst_hinge_line_mm);
+  }
   std::string describe() const;
 };
 
