@@ -4,8 +4,10 @@
 // the body's surface and seen by the cameras in front of it (all_visible:0, the half-space
 // of its outward normal: about half the ring) or by every camera (all_visible:1). Every
 // camera pair's triangulator plus the N-view merge (tests/stereo/rig_stereo_stage.h), in
-// four forms measured in the same run:
-//  - BM_StereoRigIndexed: blobs undistorted once per camera, sorted sweep, indexed merge;
+// several forms measured in the same run (the merge alone: a row minus PairsOnly):
+//  - BM_StereoRigIndexed: blobs undistorted once per camera, sorted sweep, indexed merge
+//    with claims (multiview.h: later pairs of a claimed marker are not extended);
+//  - BM_StereoRigReference: the same without claims (the reference merge);
 //  - BM_StereoRigPairUndistort: the same, every pair undistorting its blobs;
 //  - BM_StereoRigLinearMerge: the search before the index (pairs undistort, sorted
 //    sweep, linear-scan merge);
@@ -60,9 +62,12 @@ void run_rig_stage(benchmark::State& state, const test::StagePath& path) {
       static_cast<double>(std::max<std::uint64_t>(1, stage.merger.counters().frames));
   state.counters["hypotheses_per_frame"] =
       static_cast<double>(stage.merger.counters().hypotheses) / frames_run;
+  state.counters["claimed_per_frame"] =
+      static_cast<double>(stage.merger.counters().claimed) / frames_run;
 }
 
 void BM_StereoRigIndexed(benchmark::State& s) { run_rig_stage(s, test::kIndexedPath); }
+void BM_StereoRigReference(benchmark::State& s) { run_rig_stage(s, test::kReferencePath); }
 void BM_StereoRigPairUndistort(benchmark::State& s) { run_rig_stage(s, test::kPairUndistortPath); }
 void BM_StereoRigLinearMerge(benchmark::State& s) { run_rig_stage(s, test::kLinearMergePath); }
 void BM_StereoRigPairsOnly(benchmark::State& s) { run_rig_stage(s, test::kPairsOnlyPath); }
@@ -74,6 +79,7 @@ void BM_StereoRigBruteForce(benchmark::State& s) { run_rig_stage(s, test::kBrute
       ->ArgNames({"cameras", "markers", "all_visible"})    \
       ->Unit(benchmark::kMicrosecond)
 MOCAP_RIG_ROWS(BM_StereoRigIndexed);
+MOCAP_RIG_ROWS(BM_StereoRigReference);
 MOCAP_RIG_ROWS(BM_StereoRigPairUndistort);
 MOCAP_RIG_ROWS(BM_StereoRigLinearMerge);
 MOCAP_RIG_ROWS(BM_StereoRigBruteForce);

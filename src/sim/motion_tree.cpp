@@ -13,19 +13,19 @@
 namespace mocap::sim {
 namespace {
 
-constexpr double kTwoPi = 2.0 * std::numbers::pi;
+constexpr double kFullTurnRad = 2.0 * std::numbers::pi;
 constexpr double kGolden = 0.6180339887498949;
 
-double frac(double x) { return x - std::floor(x); }
+double fractional_part(double x) { return x - std::floor(x); }
 
 int dof_count(const SimJoint& j) { return j.type == JointType::kBall ? 3 : 1; }
 
 // The root's sway and turn about the robot's centre at time t (smooth, explore).
 Iso3 root_motion(const SimScene& scene, double t) {
-  const Vec3 shift(50.0 * std::sin(kTwoPi * 0.21 * t + 0.4),
-                   80.0 * std::sin(kTwoPi * 0.15 * t + 1.3),
-                   20.0 * std::sin(kTwoPi * 0.43 * t + 2.2));
-  const Mat3 R = rot_z(25.0 * kRadPerDeg * std::sin(kTwoPi * 0.11 * t + 0.7));
+  const Vec3 shift(50.0 * std::sin(kFullTurnRad * 0.21 * t + 0.4),
+                   80.0 * std::sin(kFullTurnRad * 0.15 * t + 1.3),
+                   20.0 * std::sin(kFullTurnRad * 0.43 * t + 2.2));
+  const Mat3 R = rot_z(25.0 * kRadPerDeg * std::sin(kFullTurnRad * 0.11 * t + 0.7));
   const Vec3& c = scene.robot_center_world;
   return make_iso(R, c + shift - R * c);
 }
@@ -44,8 +44,8 @@ void plan_sinusoids(const SimScene& scene, const MotionSpec& spec, double share,
       for (int i = 0; i < dof_count(j); ++i, ++d) {
         const double mid = 0.5 * (j.lower_rad[i] + j.upper_rad[i]);
         const double half = 0.5 * (j.upper_rad[i] - j.lower_rad[i]);
-        const double phase = kTwoPi * frac(0.37 + d * kGolden * 3.7);
-        c.q_rad[k][i] = mid + share * half * std::sin(kTwoPi * hz(d) * t + phase);
+        const double phase = kFullTurnRad * fractional_part(0.37 + d * kGolden * 3.7);
+        c.q_rad[k][i] = mid + share * half * std::sin(kFullTurnRad * hz(d) * t + phase);
       }
     }
     plan.configs.push_back(c);
@@ -97,14 +97,14 @@ JointConfig tree_fixed_pose(const SimScene& scene) {
 
 void plan_tree_smooth(const SimScene& scene, const MotionSpec& spec, MotionPlan& plan) {
   plan_sinusoids(
-      scene, spec, 0.8, [](int d) { return 0.25 + 0.5 * frac(d * kGolden); }, plan);
+      scene, spec, 0.8, [](int d) { return 0.25 + 0.5 * fractional_part(d * kGolden); }, plan);
 }
 
 void plan_tree_explore(const SimScene& scene, const MotionSpec& spec, MotionPlan& plan) {
   const double duration_s = spec.frames / spec.fps;
   plan_sinusoids(
       scene, spec, 0.95,
-      [duration_s](int d) { return std::min(1.2, (1.0 + frac(d * kGolden)) / duration_s); }, plan);
+      [duration_s](int d) { return std::min(1.2, (1.0 + fractional_part(d * kGolden)) / duration_s); }, plan);
 }
 
 void plan_tree_poses(const SimScene& scene, const MotionSpec& spec, MotionPlan& plan) {
@@ -116,10 +116,10 @@ void plan_tree_poses(const SimScene& scene, const MotionSpec& spec, MotionPlan& 
     for (std::size_t k = 0; k < scene.tree.size(); ++k) {
       const SimJoint& j = scene.tree[k];
       for (int i = 0; i < dof_count(j); ++i, ++d) {
-        // A Weyl sequence per degree of freedom (frac(sqrt(prime))): well spread for
+        // A Weyl sequence per degree of freedom (fractional_part(sqrt(prime))): well spread for
         // any number of poses, unlike Halton in large bases.
         const double u =
-            frac(0.5 + (p + 1) * std::sqrt(static_cast<double>(kPrimes[d % kPrimes.size()])));
+            fractional_part(0.5 + (p + 1) * std::sqrt(static_cast<double>(kPrimes[d % kPrimes.size()])));
         const double jitter = rng.uniform(-0.03, 0.03);
         c.q_rad[k][i] = j.lower_rad[i] + (0.05 + 0.9 * std::clamp(u + jitter, 0.0, 1.0)) *
                                              (j.upper_rad[i] - j.lower_rad[i]);

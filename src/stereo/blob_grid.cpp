@@ -34,6 +34,10 @@ Expected<BlobGrid> BlobGrid::create(int width_px, int height_px, double cell_px,
   const auto cells = static_cast<std::size_t>(g.gw_) * static_cast<std::size_t>(g.gh_);
   g.cells_.assign(cells, Cell{});
   g.next_.assign(static_cast<std::size_t>(max_blobs), -1);
+  g.fw_ = std::max(1, static_cast<int>(std::ceil(width_px / kOccupiedRadiusPx)));
+  g.fh_ = std::max(1, static_cast<int>(std::ceil(height_px / kOccupiedRadiusPx)));
+  const auto bits = static_cast<std::size_t>(g.fw_) * static_cast<std::size_t>(g.fh_);
+  g.occupied_.assign((bits + 63) / 64, 0);
   return g;
 }
 
@@ -60,6 +64,23 @@ int BlobGrid::build(const Vec2* px, int n) noexcept {
     next_[static_cast<std::size_t>(j)] = c.head;
     c.head = j;
   }
+  // Occupancy: every cell the square of kOccupiedRadiusPx (+ rounding) around a blob meets.
+  std::fill(occupied_.begin(), occupied_.end(), 0);
+  constexpr double inv = 1.0 / kOccupiedRadiusPx;
+  for (int j = 0; j < n_; ++j) {
+    const Vec2& p = px[j];
+    if (!std::isfinite(p.x()) || !std::isfinite(p.y())) continue;
+    const double w =
+        kOccupiedRadiusPx * (1.0 + 1e-9) + 1e-6 + 1e-9 * (std::abs(p.x()) + std::abs(p.y()));
+    const int x0 = grid_cell(p.x() - w, inv, fw_), x1 = grid_cell(p.x() + w, inv, fw_);
+    const int y0 = grid_cell(p.y() - w, inv, fh_), y1 = grid_cell(p.y() + w, inv, fh_);
+    for (int y = y0; y <= y1; ++y)
+      for (int x = x0; x <= x1; ++x) {
+        const std::size_t bit = static_cast<std::size_t>(y) * static_cast<std::size_t>(fw_) +
+                                static_cast<std::size_t>(x);
+        occupied_[bit >> 6] |= std::uint64_t{1} << (bit & 63);
+      }
+  }
   return n_;
 }
 
@@ -78,6 +99,16 @@ int BlobGrid::nearest_scan(const Vec2& q, double radius_px, double& d2_out) cons
 }
 
 int BlobGrid::nearest(const Vec2& q, double radius_px, double& d2_out) const noexcept {
+  if (std::abs(radius_px) <= kOccupiedRadiusPx && std::isfinite(q.x()) && std::isfinite(q.y())) {
+    constexpr double inv = 1.0 / kOccupiedRadiusPx;
+    const std::size_t bit =
+        static_cast<std::size_t>(grid_cell(q.y(), inv, fh_)) * static_cast<std::size_t>(fw_) +
+        static_cast<std::size_t>(grid_cell(q.x(), inv, fw_));
+    if ((occupied_[bit >> 6] >> (bit & 63) & 1u) == 0) {  // no blob within the radius
+      d2_out = radius_px * radius_px;
+      return -1;
+    }
+  }
   // A blob with d2 <= r^2 (rounded) lies within |r| of q up to rounding: widen by far more.
   const double w =
       std::abs(radius_px) * (1.0 + 1e-9) + 1e-9 + 1e-12 * (std::abs(q.x()) + std::abs(q.y()));
@@ -105,6 +136,51 @@ int BlobGrid::nearest(const Vec2& q, double radius_px, double& d2_out) const noe
     }
   }
   d2_out = best_d2;
+  return best;
+}
+
+namespace {
+// One candidate of nearest_two(): the nearest (the scan's tie rule) and the runner-up.
+inline void take_two(int j, double d2, int& best, double& best_d2, double& second_d2) noexcept {
+  if (d2 < best_d2 || (d2 == best_d2 && j > best)) {
+    if (best >= 0) second_d2 = std::min(second_d2, best_d2);
+    best_d2 = d2;
+    best = j;
+  } else if (d2 < second_d2) {
+    second_d2 = d2;
+  }
+}
+}  // namespace
+
+int BlobGrid::nearest_two(const Vec2& q, double radius_px, double& d2_out,
+                          double& second_d2_out) const noexcept {
+  int best = -1;
+  double best_d2 = radius_px * radius_px;
+  double second_d2 = best_d2;
+  const double w =
+      std::abs(radius_px) * (1.0 + 1e-9) + 1e-9 + 1e-12 * (std::abs(q.x()) + std::abs(q.y()));
+  int x0 = 0, x1 = -1, y0 = 0, y1 = -1;
+  if (std::isfinite(w) && std::isfinite(q.x()) && std::isfinite(q.y())) {
+    x0 = grid_cell(q.x() - w, inv_cell_, gw_);
+    x1 = grid_cell(q.x() + w, inv_cell_, gw_);
+    y0 = grid_cell(q.y() - w, inv_cell_, gh_);
+    y1 = grid_cell(q.y() + w, inv_cell_, gh_);
+  }
+  if (x1 < x0 || (x1 - x0 + 1) * (y1 - y0 + 1) > kGridMaxQueryCells) {
+    for (int j = 0; j < n_; ++j) take_two(j, (px_[j] - q).squaredNorm(), best, best_d2, second_d2);
+  } else {
+    for (int y = y0; y <= y1; ++y) {
+      const std::size_t row = static_cast<std::size_t>(y) * static_cast<std::size_t>(gw_);
+      for (int x = x0; x <= x1; ++x) {
+        const Cell& cell = cells_[row + static_cast<std::size_t>(x)];
+        if (cell.stamp != generation_) continue;
+        for (int j = cell.head; j >= 0; j = next_[static_cast<std::size_t>(j)])
+          take_two(j, (px_[j] - q).squaredNorm(), best, best_d2, second_d2);
+      }
+    }
+  }
+  d2_out = best_d2;
+  second_d2_out = second_d2;
   return best;
 }
 

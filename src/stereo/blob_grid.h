@@ -10,6 +10,12 @@
 // (best_d2 starting at r * r) returns: the largest index among the blobs of smallest d2
 // with d2 <= r2, d2 computed by the same expression. The query rectangle is widened by a
 // rounding margin, and a non-finite query (or one covering many cells) runs that scan.
+// Empty lookups (most: a ghost's projections) stop at an occupancy bitmap of 8 px cells
+// marking every cell within kOccupiedRadiusPx (8 px, plus a rounding margin) of a blob:
+// a query of radius <= 8 px whose cell is unmarked has no blob within its radius (the
+// answer the scan gives: -1, r^2). Clamped like the grid, so blobs and queries outside
+// the image meet in the border cells.
+// nearest_two() also reports the second smallest distance (the merge's claims, multiview.h).
 // Capacity (max_blobs) is fixed at create(); build() ignores and counts further blobs.
 #pragma once
 
@@ -35,8 +41,16 @@ class BlobGrid {
   // when there is none).
   int nearest(const Vec2& q, double radius_px, double& d2_out) const noexcept;
 
+  // nearest(), and the smallest d2 among the other blobs within the radius (r^2 when
+  // there is none) in second_d2_out: the margin by which the answer is the nearest.
+  int nearest_two(const Vec2& q, double radius_px, double& d2_out,
+                  double& second_d2_out) const noexcept;
+
   // The same by the linear scan over every indexed blob (the reference).
   int nearest_scan(const Vec2& q, double radius_px, double& d2_out) const noexcept;
+
+  // Radius (px) up to which an unmarked occupancy cell answers "none" (see above).
+  static constexpr double kOccupiedRadiusPx = 8.0;
 
   int capacity() const noexcept { return static_cast<int>(next_.size()); }
   int size() const noexcept { return n_; }
@@ -56,6 +70,9 @@ class BlobGrid {
   };
   std::vector<Cell> cells_;  // row-major, gw_ x gh_
   std::vector<int> next_;    // per blob: next blob of its cell, -1: last
+  int fw_ = 1;               // occupancy cells (kOccupiedRadiusPx squares) per row
+  int fh_ = 1;
+  std::vector<std::uint64_t> occupied_;  // fw_ x fh_ bits, row-major
 };
 
 }  // namespace mocap

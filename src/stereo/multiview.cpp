@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <string>
 #include <utility>
 
@@ -37,7 +38,11 @@ Expected<MultiViewMerger> MultiViewMerger::create(const Rig& rig, const MultiVie
   }
   auto same_index = BlobSetIndex::create(config.max_hypotheses);
   if (!same_index) return Error{"multiview: " + same_index.error().message};
-  return MultiViewMerger(rig, config, std::move(grids), std::move(same_index).value());
+  MultiViewConfig c = config;
+  // Test-only switch (setup): run the reference in an unmodified binary (`mocap track`).
+  if (const char* e = std::getenv("MOCAP_MULTIVIEW_REFERENCE"); e != nullptr && e[0] == '1')
+    c.claim_views = false;
+  return MultiViewMerger(rig, c, std::move(grids), std::move(same_index).value());
 }
 
 MultiViewMerger::MultiViewMerger(const Rig& rig, const MultiViewConfig& config,
@@ -52,7 +57,12 @@ MultiViewMerger::MultiViewMerger(const Rig& rig, const MultiViewConfig& config,
       order_(static_cast<std::size_t>(config.max_hypotheses)),
       taken_by_(rig.cameras.size() * static_cast<std::size_t>(config.max_points_per_camera)),
       grids_(std::move(grids)),
-      same_index_(std::move(same_index)) {}
+      same_index_(std::move(same_index)),
+      claims_(static_cast<std::size_t>(config.max_hypotheses)),
+      claim_of_(rig.cameras.size() * static_cast<std::size_t>(config.max_points_per_camera)),
+      dup_head_(static_cast<std::size_t>(config.max_hypotheses)),
+      dup_next_(static_cast<std::size_t>(config.max_hypotheses)),
+      dup_tail_(static_cast<std::size_t>(config.max_hypotheses)) {}
 
 double MultiViewMerger::unfit_gate_px(int c, const Vec3& X_world) const noexcept {
   const CameraModel& cam = cams_[static_cast<std::size_t>(c)];
@@ -248,35 +258,85 @@ bool MultiViewMerger::process(const Vec2* const* px, const int* n, const PointLi
     }
   }
   same_index_.clear(count);
+  const bool claims = config_.claim_views;
+  if (claims) {
+    claim_count_ = 0;
+    std::fill(claim_of_.begin(), claim_of_.end(), -1);
+  }
+  int keys = 0;  // hypotheses in order_ (claimed ones follow their claim, dup lists)
   for (int i = 0; i < count; ++i) {
     Point3& h = hyp_[static_cast<std::size_t>(i)];
-    extend(i);
-    extended_[static_cast<std::size_t>(i)] = h.blob_index;
-    // The same point from another pair: the same blobs once extended.
-    const int same = same_as_earlier(i);
-    if (same >= 0) {
-      h = hyp_[static_cast<std::size_t>(same)];  // refined already
-      partial_views_[static_cast<std::size_t>(i)] = partial_views_[static_cast<std::size_t>(same)];
-    } else {
-      refine(i, px);
+    dup_head_[static_cast<std::size_t>(i)] = -1;
+    const int claim_hyp = claims ? take_claimed(i) : -1;
+    if (claim_hyp < 0) {
+      extend(i);
+      extended_[static_cast<std::size_t>(i)] = h.blob_index;
+      // The same point from another pair: the same blobs once extended.
+      const int same = same_as_earlier(i);
+      if (same >= 0) {
+        h = hyp_[static_cast<std::size_t>(same)];  // refined already
+        partial_views_[static_cast<std::size_t>(i)] =
+            partial_views_[static_cast<std::size_t>(same)];
+      } else {
+        refine(i, px);
+        if (claims) make_claim(i);
+      }
     }
     views_[static_cast<std::size_t>(i)] = h.blob_index.count();
-    order_[static_cast<std::size_t>(i)] =
+    if (claim_hyp >= 0) {  // after its claim in index order (the sort's last key)
+      const auto j = static_cast<std::size_t>(claim_hyp);
+      dup_next_[static_cast<std::size_t>(i)] = -1;
+      if (dup_head_[j] < 0)
+        dup_head_[j] = i;
+      else
+        dup_next_[static_cast<std::size_t>(dup_tail_[j])] = i;
+      dup_tail_[j] = i;
+      continue;
+    }
+    order_[static_cast<std::size_t>(keys++)] =
         AcceptKey{views_[static_cast<std::size_t>(i)], partial_views_[static_cast<std::size_t>(i)],
                   h.reproj_px, i};
   }
   // The keys sit side by side (not looked up in hyp_): the sort touches one small array.
-  std::sort(order_.begin(), order_.begin() + count, [](const AcceptKey& a, const AcceptKey& b) {
+  const auto by_acceptance = [](const AcceptKey& a, const AcceptKey& b) {
     if (a.views != b.views) return a.views > b.views;
     // Then the cameras that see part of the ball there: a ghost (two blobs of different
     // markers on one epipolar line) has no image at all in the other cameras.
     if (a.partial != b.partial) return a.partial > b.partial;
     return a.reproj_px != b.reproj_px ? a.reproj_px < b.reproj_px : a.index < b.index;
-  });
-  const std::size_t per_cam = static_cast<std::size_t>(config_.max_points_per_camera);
+  };
+  std::sort(order_.begin(), order_.begin() + keys, by_acceptance);
+  if (keys < count && ties_a_claim(keys)) {
+    // A claim's key ties another's exactly (exact duplicate blobs): its claimed copies
+    // might interleave with that one; sort every hypothesis, as the reference does.
+    for (int i = 0; i < count; ++i) {
+      dup_head_[static_cast<std::size_t>(i)] = -1;
+      order_[static_cast<std::size_t>(i)] = AcceptKey{
+          views_[static_cast<std::size_t>(i)], partial_views_[static_cast<std::size_t>(i)],
+          hyp_[static_cast<std::size_t>(i)].reproj_px, i};
+    }
+    keys = count;
+    std::sort(order_.begin(), order_.begin() + keys, by_acceptance);
+  }
   std::fill(taken_by_.begin(), taken_by_.end(), -1);
-  for (int r = 0; r < count; ++r) {
+  for (int r = 0; r < keys; ++r) {
     const int i = order_[static_cast<std::size_t>(r)].index;
+    const bool taken = accept(i, px, out, complete);
+    int d = dup_head_[static_cast<std::size_t>(i)];
+    if (d >= 0 && taken && owns_a_blob(out.size() - 1)) {
+      // Its copies' blobs are a taken point's hypothesis's: each one is merged.
+      for (; d >= 0; d = dup_next_[static_cast<std::size_t>(d)]) ++counters_.merged;
+    }
+    for (; d >= 0; d = dup_next_[static_cast<std::size_t>(d)]) accept(d, px, out, complete);
+  }
+  return complete;
+}
+
+// Step 4 for hypothesis i (see the design comment); true when it was taken (emitted).
+bool MultiViewMerger::accept(int i, const Vec2* const* px, PointList& out,
+                             bool& complete) noexcept {
+  const std::size_t per_cam = static_cast<std::size_t>(config_.max_points_per_camera);
+  {
     Point3 h = hyp_[static_cast<std::size_t>(i)];
     const int views = views_[static_cast<std::size_t>(i)];
     // The taken points using one of h's blobs (at most one per camera).
@@ -303,11 +363,11 @@ bool MultiViewMerger::process(const Vec2* const* px, const int* n, const PointLi
     });
     if (same_as_taken) {
       ++counters_.merged;  // the same blobs: the same point from another pair
-      continue;
+      return false;
     }
     if (n_owners == 1 && is_unfit_pairing(i, out[owners[0]], px)) {
       ++counters_.unfit_pairings;  // the owner's marker, paired through its unfit view
-      continue;
+      return false;
     }
     if (n_owners > 0 && split_from_owners(h, owners, n_owners, out, px)) {
       ++counters_.shared_views_split;  // another marker's blob merged with this one's
@@ -316,14 +376,14 @@ bool MultiViewMerger::process(const Vec2* const* px, const int* n, const PointLi
     }
     if (richer_owner) {
       ++counters_.ghosts_rejected;  // a blob of a point that more cameras confirm
-      continue;
+      return false;
     }
     h.ambiguous = n_owners > 0;
     h.reported = !h.ambiguous;
     if (out.size() >= out.capacity() || static_cast<std::size_t>(out.size()) >= out_hyp_.size()) {
       ++counters_.point_overflow;
       complete = false;
-      continue;
+      return false;
     }
     const int index = out.size();
     for (int c = 0; c < camera_count(); ++c) {
@@ -341,8 +401,8 @@ bool MultiViewMerger::process(const Vec2* const* px, const int* n, const PointLi
     out_hyp_[static_cast<std::size_t>(index)] = i;
     out.push_back(h);
     ++counters_.points;
+    return true;
   }
-  return complete;
 }
 
 }  // namespace mocap

@@ -38,6 +38,23 @@
 // a hypothesis's blobs from a blob -> point table. MergeSearch::kExhaustive runs the
 // same steps by linear scans (every blob, every earlier hypothesis): the reference, with
 // an identical result (tests/stereo/test_stereo_index.cpp).
+// Claims (MultiViewConfig::claim_views, multiview_claims.cpp): most hypotheses are the
+// same marker from another pair, whose extension would find exactly the blobs an earlier
+// hypothesis found. The first hypothesis of a blob set with three or more views (after
+// its refinement) claims its blobs, with a margin per camera (computed when a later pair
+// first needs it): how far (mm) a point may move from the refined point before some
+// camera's extension could change (the nearest blob's lead over the gate, over the
+// runner-up, over the unfit gate; converted with the projection's Jacobian, twice over
+// for the non-linearity, within 0.2 % of the depth). A later pair whose two blobs are
+// both of one claim and whose own point lies within every
+// other camera's margin is given that hypothesis's result without extension: what the
+// extension and the duplicate lookup would have given it, bit for bit (the same blobs,
+// the same first equal set). Any other hypothesis (ghosts, pairs with blobs of two
+// claims, split blobs, merged images, unfit views that sit near the gate: zero margins)
+// takes the full treatment, so the acceptance sees the reference's hypotheses. The
+// reference (claim_views = false, or MOCAP_MULTIVIEW_REFERENCE=1 in the environment at
+// create(): a switch for end-to-end comparisons) extends every hypothesis; the output and
+// every counter but `claimed` are the same (tests/stereo/test_multiview_claims.cpp).
 // Capacity is fixed in create(); process() is noexcept and allocation-free; overflows
 // and rejections are counters. Each output point records its blob per camera.
 #pragma once
@@ -73,6 +90,9 @@ struct MultiViewConfig {
   // Cell of the per-camera blob grid (px): a few times the lookup radius (the gate plus
   // a ball's image radius), so a lookup visits one to four cells.
   double grid_cell_px = 64.0;
+  // Later pairs of a claimed marker take the claim's result without extension (the same
+  // result; see the design comment). false: every hypothesis is extended (the reference).
+  bool claim_views = true;
 };
 
 struct MultiViewCounters {
@@ -90,6 +110,7 @@ struct MultiViewCounters {
   std::uint64_t points = 0;               // emitted points
   std::uint64_t point_overflow = 0;       // emitted points beyond the output's capacity
   std::uint64_t blob_overflow = 0;        // blobs beyond max_points_per_camera (ignored)
+  std::uint64_t claimed = 0;              // hypotheses given a claim's result unextended
 };
 
 class MultiViewMerger {
@@ -132,6 +153,21 @@ class MultiViewMerger {
   bool split_from_owners(Point3& h, const int* owners, int n_owners, const PointList& out,
                          const Vec2* const* px) const noexcept;
 
+  // Claims: the first hypothesis of a blob set with 3+ views claims its blobs.
+  void make_claim(int i) noexcept;
+  // Gives hypothesis i its claim's result when that is what extension would give:
+  // returns the claim's hypothesis, or -1 (i untouched).
+  int take_claimed(int i) noexcept;
+  // Step 4 for hypothesis i; true when it was emitted.
+  bool accept(int i, const Vec2* const* px, PointList& out, bool& complete) noexcept;
+  // Whether two of the first `keys` sorted keys tie exactly and one has claimed copies.
+  bool ties_a_claim(int keys) const noexcept;
+  // Whether output point o owns a blob of its hypothesis (taken_by_).
+  bool owns_a_blob(int o) const noexcept;
+  // How far (mm) a point may move from X before camera c's extension changes; v: the
+  // claim's blob in c (-1: none). Adds 1 to unfit when c has an unfit view there.
+  double claim_margin_mm(int c, int v, const Vec3& X, int& unfit) const noexcept;
+
   std::vector<CameraModel> cams_;
   MultiViewConfig config_;
   std::vector<Point3> hyp_;         // workspace: this frame's hypotheses
@@ -149,6 +185,19 @@ class MultiViewMerger {
   std::vector<int> taken_by_;     // [camera * max_points_per_camera + blob]: output index
   std::vector<BlobGrid> grids_;   // per camera: this frame's blobs by image cell
   BlobSetIndex same_index_;       // this frame's extended blob sets -> first hypothesis
+  struct Claim {
+    int hyp;  // the claiming hypothesis (first of its blob set)
+    // Per camera, computed when a later pair first needs it (-1: not yet; see
+    // claim_margin_mm), and whether that camera has an unfit view at the claim's point.
+    std::array<double, kMaxCameras> margin_mm;
+    std::array<std::uint8_t, kMaxCameras> unfit;
+  };
+  std::vector<Claim> claims_;  // this frame's claims
+  int claim_count_ = 0;
+  std::vector<int> claim_of_;  // [camera * max_points_per_camera + blob]: claim, -1: none
+  // Per hypothesis: its claimed copies in index order (accepted right after it, as the
+  // reference's sort puts them: the same key but the index), a list by head/next/tail.
+  std::vector<int> dup_head_, dup_next_, dup_tail_;
   MultiViewCounters counters_;
 };
 

@@ -1,6 +1,7 @@
 // Design: see chain_solver.h. The per-frame driver of chain tracking: anchors and
 // available points, labelling from the roots, the solve/test/drop loop, and every
 // joint's solved-by flag and standard deviations.
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <bitset>
 #include <cmath>
@@ -19,8 +20,10 @@ Mat3 exp_hinge(const Vec3& axis, double a) noexcept {
   return Eigen::AngleAxisd(a, axis).toRotationMatrix();
 }
 
+}  // namespace
+
 // Euler-angle standard deviations for a rotation increment covariance (parent frame).
-std::array<double, 3> euler_sd_of(const Mat3& R, const Mat3& cov) noexcept {
+std::array<double, 3> chain_detail::euler_sd(const Mat3& R, const Mat3& cov) noexcept {
   constexpr double h = 1e-6;
   Mat3 J;
   for (int k = 0; k < 3; ++k) {
@@ -35,12 +38,12 @@ std::array<double, 3> euler_sd_of(const Mat3& R, const Mat3& cov) noexcept {
           std::sqrt(std::max(0.0, C(2, 2)))};
 }
 
-}  // namespace
-
 void ChainSolver::solve(const MeasuredPoint* pts, int n, std::int64_t t_ns, const BodyPoses& poses,
-                        ChainResult& out) noexcept {
+                        ChainResult& out, const double* partial_sigma_mm) noexcept {
   ++counters_.frames;
   n = std::clamp(n, 0, kMaxPoints);
+  partial_sigma_mm_ = partial_sigma_mm;
+  partial_sigma_count_ = n;
   const int nj = model_.joint_count();
   const int nb = std::min(model_.body_count(), poses.count);
   for (int j = 0; j < nj; ++j) {
@@ -49,6 +52,7 @@ void ChainSolver::solve(const MeasuredPoint* pts, int n, std::int64_t t_ns, cons
   }
   for (std::size_t b = 0; b < kMaxBodies; ++b) {
     out.chain_body[b] = false;
+    out.refined_body[b] = false;
     out.markers[b] = 0;
     out.rms_mm[b] = 0.0;
     out.point_index_of_marker[b].fill(-1);
@@ -143,7 +147,7 @@ void ChainSolver::solve(const MeasuredPoint* pts, int n, std::int64_t t_ns, cons
             const int p = out.point_index_of_marker[ub][m];
             if (p < 0) continue;
             const double e = (out.T_world_body[ub] * markers[m] - pts[p].X_world).squaredNorm() /
-                             sigma_sq(pts[p]);
+                             sigma_sq(p, pts[p]);
             if (e > worst) worst = e, wb = b, wm = static_cast<int>(m);
           }
         }
@@ -165,8 +169,16 @@ void ChainSolver::solve(const MeasuredPoint* pts, int n, std::int64_t t_ns, cons
       bool dropped = false;
       for (int j = 0; j < nj; ++j) {
         if (!active_[static_cast<std::size_t>(j)]) continue;
-        const auto sd = active_sd(j);
-        if (std::max({sd[0], sd[1], sd[2]}) > config_.max_sd_deg * std::numbers::pi / 180.0) {
+        // The rotation's largest standard deviation (free of the Euler convention, whose
+        // component sds grow near gimbal lock however well the rotation is known).
+        const auto uj = static_cast<std::size_t>(j);
+        const double sd = model_.joint(j).dof == 1
+                              ? sd_dof_[static_cast<std::size_t>(dof_offset_[uj])]
+                              : std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Mat3>(
+                                                            cov_[uj], Eigen::EigenvaluesOnly)
+                                                            .eigenvalues()
+                                                            .maxCoeff()));
+        if (sd > config_.max_sd_deg * std::numbers::pi / 180.0) {
           deactivate(j, out);
           ++counters_.uncertain_rejects;
           dropped = true;
@@ -210,9 +222,10 @@ void ChainSolver::solve(const MeasuredPoint* pts, int n, std::int64_t t_ns, cons
     if (cj.dof == 1) {
       r.sd_rad = {std::sqrt(std::max(0.0, cj.axis_parent.dot(cov * cj.axis_parent))), 0.0, 0.0};
     } else {
-      r.sd_rad = euler_sd_of(R_rel, cov);
+      r.sd_rad = chain_detail::euler_sd(R_rel, cov);
     }
   }
+  if (config_.enabled) check_pose_joints(pts, n, poses, out);
   for (int j = 0; j < nj; ++j) {
     const auto uj = static_cast<std::size_t>(j);
     if (out.joints[uj].solved_by == client::SolvedBy::kPoses) ++counters_.joint_poses[uj];
@@ -224,7 +237,7 @@ std::array<double, 3> ChainSolver::active_sd(int j) const noexcept {
   const auto uj = static_cast<std::size_t>(j);
   if (model_.joint(j).dof == 1)
     return {sd_dof_[static_cast<std::size_t>(dof_offset_[uj])], 0.0, 0.0};
-  return euler_sd_of(R_rel_[uj], cov_[uj]);
+  return chain_detail::euler_sd(R_rel_[uj], cov_[uj]);
 }
 
 void ChainSolver::deactivate(int j, ChainResult& out) noexcept {
@@ -242,6 +255,7 @@ void ChainSolver::deactivate(int j, ChainResult& out) noexcept {
 Mat3 ChainSolver::body_cov(int b, const BodyPoses& poses, const ChainResult& out) const noexcept {
   const auto ub = static_cast<std::size_t>(b);
   const double s2 = config_.point_sigma_mm * config_.point_sigma_mm;
+  if (out.refined_body[ub]) return refined_cov_[ub];
   if (!out.chain_body[ub]) {
     // Rigid fit: sigma^2 (sum |r|^2 I - r r^T)^-1, r about the matched markers' centroid.
     const BodyPose& bp = poses.bodies[ub];

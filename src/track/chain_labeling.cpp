@@ -73,7 +73,7 @@ int ChainSolver::label_child(int j, const Iso3& T_world_parent, const MeasuredPo
   s.markers = &markers;
   s.k = static_cast<int>(markers.size());
   for (int p = 0; p < n; ++p)
-    s.tol_mm[static_cast<std::size_t>(p)] = config_.gate_sigmas * std::sqrt(sigma_sq(pts[p]));
+    s.tol_mm[static_cast<std::size_t>(p)] = config_.gate_sigmas * std::sqrt(sigma_sq(p, pts[p]));
   for (int m = 0; m < s.k; ++m) {
     const auto um = static_cast<std::size_t>(m);
     s.cand_count[um] = 0;

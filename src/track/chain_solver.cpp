@@ -61,9 +61,11 @@ void ChainSolver::reset() noexcept {
   for (Prior& p : priors_) p.valid = false;
 }
 
-double ChainSolver::sigma_sq(const MeasuredPoint& p) const noexcept {
-  const double s = p.partial ? std::max(config_.partial_sigma_mm, config_.point_sigma_mm)
-                             : config_.point_sigma_mm;
+double ChainSolver::sigma_sq(int p, const MeasuredPoint& pt) const noexcept {
+  double partial = config_.partial_sigma_mm;
+  if (partial_sigma_mm_ != nullptr && p >= 0 && p < partial_sigma_count_)
+    partial = partial_sigma_mm_[p];
+  const double s = pt.partial ? std::max(partial, config_.point_sigma_mm) : config_.point_sigma_mm;
   return s * s + config_.model_sigma_mm * config_.model_sigma_mm;
 }
 
@@ -125,7 +127,7 @@ bool ChainSolver::gauss_newton(const MeasuredPoint* pts, const BodyPoses& poses,
         if (p < 0) continue;
         const Vec3 X = out.T_world_body[ub] * markers[m];
         const Vec3 r = X - pts[p].X_world;
-        const double w = 1.0 / sigma_sq(pts[p]);
+        const double w = 1.0 / sigma_sq(p, pts[p]);
         chi2 += w * r.squaredNorm();
         ++count;
         int k = 0;
@@ -183,8 +185,8 @@ bool ChainSolver::gauss_newton(const MeasuredPoint* pts, const BodyPoses& poses,
     for (std::size_t m = 0; m < markers.size(); ++m) {
       const int p = out.point_index_of_marker[ub][m];
       if (p >= 0)
-        chi2_ +=
-            (out.T_world_body[ub] * markers[m] - pts[p].X_world).squaredNorm() / sigma_sq(pts[p]);
+        chi2_ += (out.T_world_body[ub] * markers[m] - pts[p].X_world).squaredNorm() /
+                 sigma_sq(p, pts[p]);
     }
   }
   dof_ = 3 * residual_markers_ - ndof;

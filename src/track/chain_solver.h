@@ -27,6 +27,12 @@
 //     `confidence`); on failure the worst marker is dropped and the solve repeated; a joint
 //     left without enough markers is dropped with its descendants. Angles whose standard
 //     deviation exceeds max_sd_deg are not published either. Never a wrong angle.
+//  6. joints whose child was found by identification, the parent found or chain-solved
+//     (chain_poses.cpp): the parent's pose predicts the joint
+//     centre; a ball's child is refitted on its markers plus that centre, a hinge's two
+//     centres must agree; a chi-square failure makes the angle invalid (inconsistent).
+// A partial point's noise is derived from its image (the visible fraction of its most
+// hidden view, marker_shape.h partial_centroid_shift), passed in by FrameProcessor.
 // Every joint reports how it was solved (client::SolvedBy) and the standard deviation of
 // its angles: from the chain solve's covariance, or, for joints whose two bodies were
 // found, from the rigid fits' rotation covariances (sigma^2 (sum |r|^2 I - r r^T)^-1 per
@@ -69,6 +75,10 @@ struct LabelSearch {
   void visit(int m, int count) noexcept;
 };
 
+// Euler-angle (xyz) standard deviations of R_parent_child for a rotation-increment
+// covariance in the parent's frame (rad^2).
+std::array<double, 3> euler_sd(const Mat3& R, const Mat3& cov) noexcept;
+
 // Fixed-capacity dense storage: resized per frame up to kMaxChainDof without allocating.
 using DofMatrix =
     Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxChainDof, kMaxChainDof>;
@@ -89,9 +99,12 @@ class HeapValue {
   HeapValue(const HeapValue& o) : p_(o.p_ ? std::make_unique<T>(*o.p_) : std::make_unique<T>()) {}
   HeapValue& operator=(const HeapValue& o) {
     if (this == &o) return *this;
-    if (!o.p_) p_ = std::make_unique<T>();
-    else if (p_) *p_ = *o.p_;
-    else p_ = std::make_unique<T>(*o.p_);
+    if (!o.p_)
+      p_ = std::make_unique<T>();
+    else if (p_)
+      *p_ = *o.p_;
+    else
+      p_ = std::make_unique<T>(*o.p_);
     return *this;
   }
   HeapValue(HeapValue&&) noexcept = default;
@@ -110,24 +123,32 @@ struct ChainConfig {
   // Per-coordinate error of a marker predicted through the calibrated chain: the joint
   // centre/axis estimates plus the parent's pose noise carried over the lever.
   double model_sigma_mm = 0.35;
-  double gate_sigmas = 4.0;         // locus and pairwise-distance gates, in sigmas
-  double confidence = 0.9999;       // chi-square test of a chain solution
+  double gate_sigmas = 4.0;                     // locus and pairwise-distance gates, in sigmas
+  double confidence = 0.9999;                   // chi-square test of a chain solution
   double max_angular_speed_deg_per_s = 1440.0;  // joint speed bound of the prior gate
-  double max_prior_age_s = 0.25;    // an older last angle is no prior (cold start)
-  double max_sd_deg = 1.0;          // angles less certain than this are not published
-  int max_search_nodes = 4000;      // labelling search budget per joint and frame
+  double max_prior_age_s = 0.25;                // an older last angle is no prior (cold start)
+  double max_sd_deg = 1.0;                      // angles less certain than this are not published
+  // Per-coordinate error of a calibrated joint centre (docs/evaluation.md measures
+  // 0.02-0.09 mm): part of the centre test of joints whose child was found.
+  double centre_sigma_mm = 0.1;
+  int max_search_nodes = 4000;  // labelling search budget per joint and frame
 };
 
 struct ChainJointResult {
   client::SolvedBy solved_by = client::SolvedBy::kNone;
   std::array<double, 3> sd_rad{};  // of a0, a1, a2 (hinge: a0 only)
+  // The child found, but the two poses disagree with the calibrated joint beyond the
+  // noise (chain_poses.cpp): the angle is not valid.
+  bool inconsistent = false;
 };
 
 // Result of one frame. Bodies solved by the chain get a pose (`chain_body`) and labels.
 struct ChainResult {
   std::array<ChainJointResult, kMaxBodies> joints{};  // model order (joint_count used)
   std::array<bool, kMaxBodies> chain_body{};          // pose from the chain this frame
-  std::array<Iso3, kMaxBodies> T_world_body{};        // valid where chain_body
+  // Found by identification, pose refitted with its joint centre (check_pose_joints).
+  std::array<bool, kMaxBodies> refined_body{};
+  std::array<Iso3, kMaxBodies> T_world_body{};  // valid where chain_body or refined_body
   std::array<std::array<std::int16_t, kMaxMarkers>, kMaxBodies> point_index_of_marker{};
   std::array<int, kMaxBodies> markers{};
   std::array<double, kMaxBodies> rms_mm{};
@@ -135,14 +156,16 @@ struct ChainResult {
 
 struct ChainCounters {
   std::uint64_t frames = 0;
-  std::uint64_t attempts = 0;         // joints whose child was missing and parent anchored
-  std::uint64_t joints_solved = 0;    // chain solutions published (per joint)
-  std::uint64_t too_few_labels = 0;   // not enough unambiguous child markers
-  std::uint64_t ambiguous_labels = 0; // markers left unlabelled as ambiguous
-  std::uint64_t chi2_drops = 0;       // markers dropped by the chi-square test
-  std::uint64_t chi2_rejects = 0;     // joints dropped (test failed with too few markers)
+  std::uint64_t attempts = 0;           // joints whose child was missing and parent anchored
+  std::uint64_t joints_solved = 0;      // chain solutions published (per joint)
+  std::uint64_t too_few_labels = 0;     // not enough unambiguous child markers
+  std::uint64_t ambiguous_labels = 0;   // markers left unlabelled as ambiguous
+  std::uint64_t chi2_drops = 0;         // markers dropped by the chi-square test
+  std::uint64_t chi2_rejects = 0;       // joints dropped (test failed with too few markers)
   std::uint64_t uncertain_rejects = 0;  // joints dropped for sd > max_sd_deg
   std::uint64_t node_limit_hits = 0;
+  std::uint64_t pose_refits = 0;   // found children of ball joints refitted with the centre
+  std::uint64_t pose_rejects = 0;  // found children whose poses disagree with the joint
   // Coverage: frames in which joint j (model order) was valid, by how it was solved.
   std::array<std::uint64_t, kMaxBodies> joint_poses{};
   std::array<std::uint64_t, kMaxBodies> joint_chain{};
@@ -153,9 +176,12 @@ class ChainSolver {
   static Expected<ChainSolver> create(ChainModel model, const ChainConfig& config);
 
   // pts[0..n): this frame's points; poses: identification's result (bodies found are the
-  // anchors; read only). Fills `out` for every joint of the model.
+  // anchors; read only). Fills `out` for every joint of the model. partial_sigma_mm
+  // (optional, n entries): the per-coordinate noise of each partial point, derived from
+  // its image (FrameProcessor::measure_points, marker_shape.h); without it a
+  // partial point has the configured partial_sigma_mm. Never below point_sigma_mm.
   void solve(const MeasuredPoint* pts, int n, std::int64_t timestamp_ns, const BodyPoses& poses,
-             ChainResult& out) noexcept;
+             ChainResult& out, const double* partial_sigma_mm = nullptr) noexcept;
   // Remembers the relative rotation of every joint valid this frame (the priors of the
   // next frame): call with the final poses (identified and chain-solved).
   void remember(const BodyPoses& poses, std::int64_t timestamp_ns) noexcept;
@@ -186,7 +212,21 @@ class ChainSolver {
   void deactivate(int j, ChainResult& out) noexcept;
   // World-frame rotation covariance of a body's pose (rad^2): rigid fit or chain.
   Mat3 body_cov(int b, const BodyPoses& poses, const ChainResult& out) const noexcept;
-  double sigma_sq(const MeasuredPoint& p) const noexcept;
+  // Per-coordinate variance of point p (index in this frame's points): its noise plus the
+  // model's marker error.
+  double sigma_sq(int p, const MeasuredPoint& pt) const noexcept;
+  // Joints whose child was found (chain_poses.cpp): ball refit with the joint centre, centre
+  // test, standard deviations.
+  void check_pose_joints(const MeasuredPoint* pts, int n, const BodyPoses& poses,
+                         ChainResult& out) noexcept;
+  // The ball joint j's found child refitted on its labels plus the centre c_w (weight
+  // W_c), dropping its worst marker while the chi-square fails; false: inconsistent.
+  bool refit_child(int j, const Vec3& c_w, const Mat3& W_c, const MeasuredPoint* pts, int n,
+                   const BodyPose& child, std::array<std::int16_t, kMaxMarkers>& labels, Iso3& T_wc,
+                   Mat3& cov_R) const noexcept;
+  // Covariance (mm^2, world) of the joint centre c_world as placed by body b's pose.
+  Mat3 centre_cov(int b, const Vec3& c_world, const BodyPoses& poses,
+                  const ChainResult& out) const noexcept;
 
   ChainModel model_;
   ChainConfig config_;
@@ -199,10 +239,13 @@ class ChainSolver {
   std::array<Mat3, kMaxBodies> R_rel_{};      // by joint index
   std::array<int, kMaxBodies> dof_offset_{};  // by joint index
   std::array<double, kMaxChainDof> sd_dof_{};
+  const double* partial_sigma_mm_ = nullptr;  // this frame's (solve()), or null
+  int partial_sigma_count_ = 0;
   double chi2_ = 0.0;
   int residual_markers_ = 0;
   int dof_ = 0;
   std::array<Mat3, kMaxBodies> cov_{};          // ball: 3x3 covariance of the increment
+  std::array<Mat3, kMaxBodies> refined_cov_{};  // by body: world rotation cov of a refit
   // gauss_newton()'s normal equations (~146 KiB: heap, allocated with the solver)
   chain_detail::HeapValue<chain_detail::NormalEquations> normal_;
   chain_detail::LabelSearch search_;

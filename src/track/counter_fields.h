@@ -98,7 +98,7 @@ inline constexpr std::array<CounterField<StereoCounters>, 14> kStereoFields = {{
 }};
 
 // Reported as multiview_<name>, with three or more cameras.
-inline constexpr std::array<CounterField<MultiViewCounters>, 14> kMultiViewFields = {{
+inline constexpr std::array<CounterField<MultiViewCounters>, 15> kMultiViewFields = {{
     MOCAP_COUNTER_FIELD(MultiViewCounters, frames),
     MOCAP_COUNTER_FIELD(MultiViewCounters, hypotheses),
     MOCAP_COUNTER_FIELD(MultiViewCounters, hypothesis_overflow),
@@ -113,6 +113,7 @@ inline constexpr std::array<CounterField<MultiViewCounters>, 14> kMultiViewField
     MOCAP_COUNTER_FIELD(MultiViewCounters, points),
     MOCAP_COUNTER_FIELD(MultiViewCounters, point_overflow),
     MOCAP_COUNTER_FIELD(MultiViewCounters, blob_overflow),
+    MOCAP_COUNTER_FIELD(MultiViewCounters, claimed),
 }};
 
 // Reported as identify_<name>.

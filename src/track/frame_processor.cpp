@@ -80,10 +80,19 @@ Expected<FrameProcessor> FrameProcessor::create(const Rig& rig, const TargetSet&
   }
   p.centroids_px_.assign(static_cast<std::size_t>(n_cams),
                          std::vector<Vec2>(static_cast<std::size_t>(config.detect.max_blobs)));
-  if (n_cams > 2)
+  if (n_cams > 2) {
     p.pair_points_.assign(static_cast<std::size_t>(n_pairs),
                           PointList(config.stereo.max_candidates));
+    for (const CameraModel& cam : rig.cameras) {
+      auto u = BlobUndistorter::create(cam, config.stereo.max_points_per_camera);
+      if (!u) return u.error();
+      p.undistorters_.push_back(std::move(u).value());
+    }
+  }
   p.measured_.resize(static_cast<std::size_t>(std::max(1, config.stereo.max_candidates)));
+  p.partial_sigma_mm_.assign(p.measured_.size(), 0.0);
+  p.marker_radius_mm_ = 0.5 * targets.marker_diameter_mm;
+  p.fallback_partial_sigma_mm_ = config.identify.partial_sigma_mm;
   p.body_views_.resize(targets.bodies.size());
   return p;
 }
@@ -156,6 +165,12 @@ void FrameProcessor::triangulate(FrameOutput& out) noexcept {
     stereo_total_ = pairs_.front().counters();
     return;
   }
+  // Each camera's blobs undistorted once, for all its pairs (the same result as each
+  // pair undistorting them).
+  UndistortedBlobs views[kMaxCameras];
+  for (int c = 0; c < n_cams; ++c)
+    if (out.camera_present[static_cast<std::size_t>(c)])
+      views[c] = undistorters_[static_cast<std::size_t>(c)].undistort(px[c], n[c]);
   const PointList* lists[kMaxCameraPairs] = {};
   int listed = 0;
   for (std::size_t k = 0; k < pairs_.size(); ++k) {
@@ -164,7 +179,7 @@ void FrameProcessor::triangulate(FrameOutput& out) noexcept {
     if (!out.camera_present[static_cast<std::size_t>(a)] ||
         !out.camera_present[static_cast<std::size_t>(b)])
       continue;
-    st.process(px[a], n[a], px[b], n[b], pair_points_[k]);
+    st.process(views[a], views[b], pair_points_[k]);
     lists[listed++] = &pair_points_[k];
   }
   merger_.process(px, n, lists, listed, out.points);
@@ -208,6 +223,35 @@ void FrameProcessor::measure_points(FrameOutput& out) noexcept {
     m.X_world = p.X_world;
     m.blob_index = p.blob_index;
     m.partial = partial;
+    // A partial point's noise for the chain (docs/chain.md, "Partial markers"): the
+    // centroid shift of its most hidden view, b(f) x the ball's radius.
+    double sigma = 0.0;
+    if (partial) {
+      double shift = 0.0;
+      for (int c = 0; c < camera_count(); ++c) {
+        const int b = p.blob_index[c];
+        if (b < 0 || whole[c] >= 0) continue;
+        const detect::BlobList& blobs = out.blobs[static_cast<std::size_t>(c)];
+        const double f = static_cast<std::size_t>(b) < blobs.size()
+                             ? shapes_[static_cast<std::size_t>(c)].visible_fraction(
+                                   blobs[static_cast<std::size_t>(b)], p.X_world)
+                             : 0.0;
+        // The view's image shift moves the point along the best partner view's ray:
+        // by the shift / sin(angle between the two rays) (docs/chain.md).
+        const Vec3 ray =
+            (p.X_world - rig_.cameras[static_cast<std::size_t>(c)].center_world()).normalized();
+        double sin_best = 0.0;
+        for (int o = 0; o < camera_count(); ++o) {
+          if (o == c || p.blob_index[o] < 0) continue;
+          const Vec3 other =
+              (p.X_world - rig_.cameras[static_cast<std::size_t>(o)].center_world()).normalized();
+          sin_best = std::max(sin_best, ray.cross(other).norm());
+        }
+        shift = std::max(shift, partial_centroid_shift(f) / std::max(sin_best, 0.05));
+      }
+      sigma = marker_radius_mm_ > 0.0 ? shift * marker_radius_mm_ : fallback_partial_sigma_mm_;
+    }
+    partial_sigma_mm_[static_cast<std::size_t>(i)] = sigma;
   }
   measured_count_ = n_points;
 }
@@ -245,6 +289,9 @@ bool FrameProcessor::process_blobs(std::int64_t timestamp_ns, FrameOutput& out) 
            ++j) {
         kinematics::JointAngle& a = out.angles.joints[j];
         if (!a.valid) continue;
+        // Two found bodies that disagree with the calibrated joint (chain_poses.cpp):
+        // one pose is wrong, so is the angle.
+        if (chain_result_.joints[j].inconsistent) a.valid = false;
         a.solved_by = chain_result_.joints[j].solved_by;
         a.sd_rad = chain_result_.joints[j].sd_rad;
       }
@@ -268,11 +315,18 @@ bool FrameProcessor::whole_marker_view(int camera, const detect::BlobList& blobs
 void FrameProcessor::track_chain(int n_points, std::int64_t timestamp_ns,
                                  FrameOutput& out) noexcept {
   if (!chain_) return;
-  chain_->solve(measured_.data(), n_points, timestamp_ns, out.poses, chain_result_);
+  chain_->solve(measured_.data(), n_points, timestamp_ns, out.poses, chain_result_,
+                partial_sigma_mm_.data());
   for (int b = 0; b < out.poses.count; ++b) {
     const auto ub = static_cast<std::size_t>(b);
     BodyPose& bp = out.poses.bodies[ub];
     bp.from_chain = false;
+    if (chain_result_.refined_body[ub]) {  // refitted with its joint centre (chain_poses.cpp)
+      bp.T_world_body = chain_result_.T_world_body[ub];
+      bp.point_index_of_marker = chain_result_.point_index_of_marker[ub];
+      bp.markers = chain_result_.markers[ub];
+      bp.rms_mm = chain_result_.rms_mm[ub];
+    }
     if (!chain_result_.chain_body[ub]) continue;
     bp.found = true;
     bp.from_chain = true;

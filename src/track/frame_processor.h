@@ -167,7 +167,11 @@ class FrameProcessor {
   // Workspace, sized at create().
   std::vector<std::vector<Vec2>> centroids_px_;  // per camera
   std::vector<PointList> pair_points_;           // per camera pair (3+ cameras)
+  std::vector<BlobUndistorter> undistorters_;    // per camera (3+ cameras): once per frame
   std::vector<MeasuredPoint> measured_;
+  std::vector<double> partial_sigma_mm_;    // per measured point: its noise when partial
+  double marker_radius_mm_ = 0.0;           // targets.yaml marker_diameter / 2 (0: unknown)
+  double fallback_partial_sigma_mm_ = 1.0;  // without a marker size: IdentifyConfig's
   int measured_count_ = 0;
   PointSelector selector_;
   std::vector<kinematics::BodyPoseView> body_views_;

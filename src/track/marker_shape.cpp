@@ -166,4 +166,42 @@ ShapeCheck MarkerShapeModel::check(const detect::Blob& blob, const Vec3& X_world
   return r;
 }
 
+double MarkerShapeModel::visible_fraction(const detect::Blob& blob,
+                                          const Vec3& X_world) const noexcept {
+  constexpr std::uint32_t kSuspect = detect::kBlobTouchesBorder | detect::kBlobMerged |
+                                     detect::kBlobSplit | detect::kBlobTruncated;
+  if ((blob.flags & kSuspect) != 0U) return 0.0;
+  Eigen::Matrix2d Sigma;
+  Vec2 centre;
+  if (!predict(X_world, Sigma, centre)) return 0.0;
+  const double det = Sigma.determinant();
+  if (!(det > 0.0)) return 0.0;
+  // A filled ellipse with semi-axes a, b has covariance eigenvalues a^2/4, b^2/4.
+  const double area_pred = 4.0 * kPi * std::sqrt(det);
+  // An area above the silhouette's is light from something else (a neighbouring ball,
+  // a reflection) merged in: the same relative mass misplaced as a hidden part, f = 1/r.
+  const double r = static_cast<double>(blob.area_px) / area_pred;
+  if (!(r > 0.0)) return 0.0;
+  return std::clamp(std::min(r, 1.0 / r), 0.0, 1.0);
+}
+
+double partial_centroid_shift(double f) noexcept {
+  if (!(f > 0.0)) return 1.0;
+  if (f >= 1.0) return 0.0;
+  // f(d) = 1 - A_s(d) / pi increases monotonically from 0 (d = -1) to 1 (d = 1).
+  const auto segment = [](double d) { return std::acos(d) - d * std::sqrt(1.0 - d * d); };
+  double lo = -1.0, hi = 1.0;
+  for (int i = 0; i < 60; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    if (1.0 - segment(mid) / kPi < f)
+      lo = mid;
+    else
+      hi = mid;
+  }
+  const double d = 0.5 * (lo + hi);
+  const double kept = kPi - segment(d);
+  const double c = 1.0 - d * d;
+  return kept > 0.0 ? std::min(1.0, 2.0 * c * std::sqrt(c) / (3.0 * kept)) : 1.0;
+}
+
 }  // namespace mocap

@@ -69,6 +69,13 @@ class MarkerShapeModel {
 
   bool enabled() const noexcept { return config_.enabled; }
 
+  // Visible fraction of the ball's silhouette in this view, in [0, 1]: the ratio r of the
+  // blob's thresholded area to the predicted silhouette's (4 pi sqrt(det Sigma_g)), or
+  // 1/r when r > 1 (light merged in from elsewhere misplaces as much mass); 0 for
+  // a flagged blob (border, merged, split, truncated: its centroid is not a cut disc's)
+  // or when there is no prediction (the worst case). See partial_centroid_shift().
+  double visible_fraction(const detect::Blob& blob, const Vec3& X_world) const noexcept;
+
  private:
   // The silhouette ellipse on the normalised undistorted plane: shape S, centre x0.
   bool silhouette(const Vec3& X_world, Eigen::Matrix2d& S, Vec2& x0,
@@ -80,6 +87,17 @@ class MarkerShapeModel {
   double z_ = 4.3;
   MarkerShapeConfig config_;
 };
+
+// Centroid shift of a partly hidden disc, in units of its radius, for a visible fraction
+// f in [0, 1]: the disc cut by a straight edge (the rim of a nearer limb or ball is much
+// larger than the marker, so locally straight). Removing the segment beyond a chord at
+// distance d from the centre (segment area A_s = acos d - d sqrt(1 - d^2), centroid at
+// 2 (1 - d^2)^(3/2) / (3 A_s)) moves the centroid of the rest by
+//   b = 2 (1 - d^2)^(3/2) / (3 (pi - A_s)),   f = 1 - A_s / pi.
+// b(1) = 0, b(1/2) = 4 / (3 pi) = 0.42, b -> 1 as f -> 0 (a thin sliver at the rim).
+// For a given hidden area the straight cut moves the centroid farthest (its removed
+// mass lies farthest out), so b(f) bounds the bias of any convex occluder's cut.
+double partial_centroid_shift(double visible_fraction) noexcept;
 
 // The measured weighted covariance (pixels^2) of a blob from its axes and orientation.
 Eigen::Matrix2d blob_covariance_px(const detect::Blob& blob) noexcept;

@@ -113,6 +113,8 @@ Expected<GroundTruth> load_ground_truth(const std::string& gt_dir) {
     if (!targets) return targets.error();
     auto model = load_model(gt_dir + "/model_true.yaml", *targets);
     if (!model) return model.error();
+    for (const JointSpec& j : model->joints)
+      gt.joints.push_back({j.name, j.parent, j.child, j.type == JointType::kHinge});
     auto angles = true_angles_from_poses(*targets, *model, gt.poses);
     if (!angles) return angles.error();
     gt.angles = std::move(angles).value();
@@ -261,8 +263,40 @@ AccuracyReport evaluate_against_truth(const GroundTruth& truth, const std::vecto
     }
     JointAccuracy& j = rep.joints[slot];
     ++j.frames;
+    if (std::abs(err) > 2.0) ++j.over_2deg;
     ang_sq[slot] += err * err;
     j.max_deg = std::max(j.max_deg, std::abs(err));
+  }
+  // Observability (truth.h), per frame, from the roots down: a body is observed with
+  // >= 3 clean markers or through an observable joint into it.
+  std::map<std::string, const GtJoint*> joint_into;
+  for (const GtJoint& gj : truth.joints) joint_into.emplace(gj.child, &gj);
+  const auto clean = [&](std::int64_t f, const std::string& body) {
+    const auto it = visible_count.find({f, body});
+    return it == visible_count.end() ? 0 : it->second;
+  };
+  for (const std::int64_t f : frames) {
+    std::map<std::string, bool> observed;
+    const auto body_observed = [&](const std::string& body, const auto& self) -> bool {
+      if (const auto it = observed.find(body); it != observed.end()) return it->second;
+      observed[body] = false;  // a loop in the model never observes a body through itself
+      bool o = clean(f, body) >= 3;
+      if (!o) {
+        const auto it = joint_into.find(body);
+        o = it != joint_into.end() && clean(f, body) >= (it->second->hinge ? 1 : 2) &&
+            self(it->second->parent, self);
+      }
+      observed[body] = o;
+      return o;
+    };
+    for (const GtJoint& gj : truth.joints) {
+      const auto js = joint_slot.find(gj.name);
+      if (js == joint_slot.end()) continue;
+      if (!body_observed(gj.parent, body_observed) || clean(f, gj.child) < (gj.hinge ? 1 : 2))
+        continue;
+      ++rep.joints[js->second].observable;
+      if (est_angles.count({f, gj.name})) ++rep.joints[js->second].valid_observable;
+    }
   }
   for (std::size_t i = 0; i < rep.joints.size(); ++i) {
     if (rep.joints[i].frames > 0) {
@@ -301,9 +335,19 @@ std::string format_accuracy(const AccuracyReport& r) {
   }
   for (const JointAccuracy& j : r.joints) {
     std::snprintf(buf, sizeof buf,
-                  "  joint %-10s angle error RMS %.4f deg, max %.4f deg over %lld frames\n",
-                  j.joint.c_str(), j.rms_deg, j.max_deg, static_cast<long long>(j.frames));
+                  "  joint %-10s angle error RMS %.4f deg, max %.4f deg over %lld frames, "
+                  "%lld > 2 deg",
+                  j.joint.c_str(), j.rms_deg, j.max_deg, static_cast<long long>(j.frames),
+                  static_cast<long long>(j.over_2deg));
     s << buf;
+    if (j.observable > 0) {
+      std::snprintf(
+          buf, sizeof buf, "; valid in %.2f%% of %lld observable frames",
+          100.0 * static_cast<double>(j.valid_observable) / static_cast<double>(j.observable),
+          static_cast<long long>(j.observable));
+      s << buf;
+    }
+    s << '\n';
   }
   return s.str();
 }

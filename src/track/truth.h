@@ -32,10 +32,19 @@ struct GtMarker {
   }
 };
 
+// A joint of the true model, for observability (evaluate_against_truth).
+struct GtJoint {
+  std::string name;
+  std::string parent;
+  std::string child;
+  bool hinge = false;
+};
+
 struct GroundTruth {
   std::vector<PoseRow> poses;
   std::vector<AngleRow> angles;
   std::vector<GtMarker> markers;  // sorted by frame
+  std::vector<GtJoint> joints;    // from model_true.yaml, when present
 };
 
 // Reads DIR/poses.csv, DIR/angles.csv (optional) and DIR/markers.csv. When DIR holds
@@ -59,11 +68,19 @@ struct BodyAccuracy {
   double rotation_rms_deg = 0.0;
 };
 
+// Observability of a joint in a frame (the issue's definition, docs/chain.md "Coverage
+// statistics"): a marker is clean when it is visible (vis = 1) in 2 or more cameras; a
+// body is observed when it has >= 3 clean markers, or when the joint into it is
+// observable; a joint is observable when its parent is observed and its child has >= 1
+// (hinge) or >= 2 (ball) clean markers. Needs GroundTruth::joints.
 struct JointAccuracy {
   std::string joint;
-  std::int64_t frames = 0;
-  double rms_deg = 0.0;  // ball: geodesic angle of the relative rotation; hinge: angle
+  std::int64_t frames = 0;  // frames with a valid angle
+  double rms_deg = 0.0;     // ball: geodesic angle of the relative rotation; hinge: angle
   double max_deg = 0.0;
+  std::int64_t over_2deg = 0;         // valid frames more than 2 deg off
+  std::int64_t observable = 0;        // frames in which the joint is observable (above)
+  std::int64_t valid_observable = 0;  // of those, frames with a valid angle
 };
 
 struct AccuracyReport {

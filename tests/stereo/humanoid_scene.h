@@ -53,6 +53,12 @@ struct SceneOptions {
   double hidden = 0.0;     // probability that a camera misses a marker
   double split = 0.0;      // probability of a second blob 0.5..3 px from a marker's
   double duplicate = 0.0;  // probability of an exact duplicate of a marker's blob
+  // Probability that a view's centroid is shifted 2..6 px (a partly hidden ball: beyond
+  // the gate, within the ball's image; an unfit view).
+  double shifted = 0.0;
+  // Probability of a second ball 14..20 mm from a marker (two balls close together);
+  // where their images lie within 5 px they merge into one blob at the mean.
+  double twin = 0.0;
   // Self-occlusion: each marker sits on the body's surface with a random outward normal
   // and is seen only by cameras within this angle of it (90: the half-space in front of
   // its tangent plane, a convex body's occlusion; 180: every camera).
@@ -73,9 +79,31 @@ inline std::vector<std::vector<Vec2>> humanoid_frame(const Rig& rig, const Scene
       normal = Vec3(u(rng), u(rng), u(rng));
     normal.normalize();
     const double min_cos = std::cos(o.facing_deg * M_PI / 180.0);
+    // Draws only for options in use: the scenes of the other options stay the same.
+    const bool twin = o.twin > 0.0 && u01(rng) < o.twin;
+    Vec3 X2 = X;
+    if (twin) {
+      Vec3 d(u(rng), u(rng), u(rng));
+      while (d.squaredNorm() < 1e-6) d = Vec3(u(rng), u(rng), u(rng));
+      X2 = X + (14.0 + 6.0 * u01(rng)) * d.normalized();
+    }
     for (std::size_t c = 0; c < rig.cameras.size(); ++c) {
       Vec2 p;
       if (!project(rig.cameras[c], X, p) || !in_image(rig.cameras[c], p)) continue;
+      if (twin) {
+        Vec2 p2;
+        if (project(rig.cameras[c], X2, p2) && in_image(rig.cameras[c], p2)) {
+          if ((p2 - p).norm() < 5.0) {
+            p = 0.5 * (p + p2);  // one merged blob
+          } else {
+            px[c].push_back(p2 + Vec2(noise(rng), noise(rng)));
+          }
+        }
+      }
+      if (o.shifted > 0.0 && u01(rng) < o.shifted) {
+        const double r = 2.0 + 4.0 * u01(rng), t = M_PI * u(rng);
+        p += r * Vec2(std::cos(t), std::sin(t));
+      }
       if (normal.dot((rig.cameras[c].center_world() - X).normalized()) < min_cos) continue;
       if (u01(rng) < o.hidden) continue;
       const Vec2 b = p + Vec2(noise(rng), noise(rng));

@@ -2,7 +2,7 @@
 // as FrameProcessor runs it (one StereoTriangulator per camera pair, then the
 // MultiViewMerger), with each choice of the search open: blobs undistorted once per camera
 // (BlobUndistorter views) or by every pair, the pairs' sorted sweep or all n*m pairs, the
-// merge's index or its linear scans.
+// merge's index or its linear scans, with or without claims (multiview.h).
 #pragma once
 
 #include <array>
@@ -19,6 +19,7 @@ struct StagePath {
   MatchMethod match = MatchMethod::kSortedSweep;
   MergeSearch merge = MergeSearch::kIndexed;
   bool run_merge = true;  // false: the pairs only (benchmarks: where the time goes)
+  bool claims = true;     // MultiViewConfig::claim_views (false: the reference merge)
 };
 // Today's path: undistorted once per camera, sorted sweep, indexed merge.
 inline constexpr StagePath kIndexedPath{};
@@ -27,13 +28,16 @@ inline constexpr StagePath kPairUndistortPath{false, MatchMethod::kSortedSweep,
                                               MergeSearch::kIndexed};
 // The search before the index: pairs undistort, sorted sweep, linear-scan merge.
 inline constexpr StagePath kLinearMergePath{false, MatchMethod::kSortedSweep,
-                                            MergeSearch::kExhaustive};
+                                            MergeSearch::kExhaustive, true, false};
+// Today's search with the reference merge: every hypothesis extended (no claims).
+inline constexpr StagePath kReferencePath{true, MatchMethod::kSortedSweep, MergeSearch::kIndexed,
+                                          true, false};
 // The pairs of the indexed path alone.
 inline constexpr StagePath kPairsOnlyPath{true, MatchMethod::kSortedSweep, MergeSearch::kIndexed,
                                           false};
 // Brute force of everything: all n*m pairs, linear-scan merge.
 inline constexpr StagePath kBruteForcePath{false, MatchMethod::kExhaustive,
-                                           MergeSearch::kExhaustive};
+                                           MergeSearch::kExhaustive, true, false};
 
 struct RigStereoStage {
   StagePath path;
@@ -48,6 +52,7 @@ struct RigStereoStage {
     c.marker_radius_mm = 7.0;
     c.max_hypotheses = 1024 * static_cast<int>(cameras * (cameras - 1) / 2);  // as FrameProcessor
     c.search = path.merge;
+    c.claim_views = path.claims;
     return c;
   }
 
