@@ -22,12 +22,14 @@
 namespace mocap {
 namespace {
 
-bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof(a)) == 0; }
+bool claims_same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof(a)) == 0; }
 
-bool identical(const Point3& a, const Point3& b) {
-  return same_bits(a.X_world.x(), b.X_world.x()) && same_bits(a.X_world.y(), b.X_world.y()) &&
-         same_bits(a.X_world.z(), b.X_world.z()) && same_bits(a.reproj_px, b.reproj_px) &&
-         same_bits(a.epipolar_px, b.epipolar_px) && a.blob_index == b.blob_index &&
+bool claims_identical(const Point3& a, const Point3& b) {
+  return claims_same_bits(a.X_world.x(), b.X_world.x()) &&
+         claims_same_bits(a.X_world.y(), b.X_world.y()) &&
+         claims_same_bits(a.X_world.z(), b.X_world.z()) &&
+         claims_same_bits(a.reproj_px, b.reproj_px) &&
+         claims_same_bits(a.epipolar_px, b.epipolar_px) && a.blob_index == b.blob_index &&
          a.ambiguous == b.ambiguous && a.reported == b.reported;
 }
 
@@ -60,7 +62,7 @@ TEST(MultiViewClaims, SameResultAsTheReferenceOnRandomScenesWithCornerCases) {
                                         << " cameras, " << so.markers << " markers");
       ASSERT_EQ(fast.out.size(), reference.out.size());
       for (int i = 0; i < fast.out.size(); ++i)
-        ASSERT_TRUE(identical(fast.out[i], reference.out[i])) << "point " << i;
+        ASSERT_TRUE(claims_identical(fast.out[i], reference.out[i])) << "point " << i;
       ++frames;
     }
     MultiViewCounters a = fast.merger.counters(), b = reference.merger.counters();
@@ -112,7 +114,7 @@ TEST(MultiViewClaims, EnvironmentSwitchRunsTheReference) {
   EXPECT_GT(on.merger.counters().claimed, 0u);
   EXPECT_EQ(off.merger.counters().claimed, 0u);
   ASSERT_EQ(on.out.size(), off.out.size());
-  for (int i = 0; i < on.out.size(); ++i) EXPECT_TRUE(identical(on.out[i], off.out[i]));
+  for (int i = 0; i < on.out.size(); ++i) EXPECT_TRUE(claims_identical(on.out[i], off.out[i]));
 }
 
 }  // namespace

@@ -25,7 +25,7 @@
 namespace mocap {
 namespace {
 
-constexpr std::int64_t kDt = 10'000'000;  // 100 fps
+constexpr std::int64_t kHumanoidDt = 10'000'000;  // 100 fps
 
 struct Humanoid {
   sim::SimScene scene;
@@ -92,7 +92,7 @@ struct Humanoid {
   }
 };
 
-double rot_err_deg(const Mat3& A, const Mat3& B) {
+double humanoid_rot_err_deg(const Mat3& A, const Mat3& B) {
   return Eigen::AngleAxisd(A.transpose() * B).angle() * 180.0 / std::numbers::pi;
 }
 
@@ -107,8 +107,8 @@ TEST(HumanoidChain, HandUnderChainSolvedForearm) {
   ChainResult r;
   const sim::SceneState st0 = h.state(1.0);
   h.frame(st0, std::vector<int>(nb, -1), std::vector<bool>(nb, true), pts, poses);
-  h.solver.solve(pts.data(), static_cast<int>(pts.size()), kDt, poses, r);
-  h.accept(poses, r, kDt);
+  h.solver.solve(pts.data(), static_cast<int>(pts.size()), kHumanoidDt, poses, r);
+  h.accept(poses, r, kHumanoidDt);
   for (int j = 0; j < h.solver.model().joint_count(); ++j)
     EXPECT_EQ(r.joints[static_cast<std::size_t>(j)].solved_by, client::SolvedBy::kPoses) << j;
 
@@ -121,15 +121,15 @@ TEST(HumanoidChain, HandUnderChainSolvedForearm) {
   found[static_cast<std::size_t>(fore)] = false;
   found[static_cast<std::size_t>(hand)] = false;
   h.frame(st1, visible, found, pts, poses);
-  h.solver.solve(pts.data(), static_cast<int>(pts.size()), 2 * kDt, poses, r);
+  h.solver.solve(pts.data(), static_cast<int>(pts.size()), 2 * kHumanoidDt, poses, r);
   ASSERT_TRUE(r.chain_body[static_cast<std::size_t>(fore)]);
   ASSERT_TRUE(r.chain_body[static_cast<std::size_t>(hand)]);
   EXPECT_EQ(r.joints[static_cast<std::size_t>(h.joint("elbow_l"))].solved_by,
             client::SolvedBy::kChain);
   EXPECT_EQ(r.joints[static_cast<std::size_t>(h.joint("wrist_l"))].solved_by,
             client::SolvedBy::kChain);
-  EXPECT_LT(rot_err_deg(r.T_world_body[static_cast<std::size_t>(hand)].linear(),
-                        st1.T_world_body[static_cast<std::size_t>(hand)].linear()),
+  EXPECT_LT(humanoid_rot_err_deg(r.T_world_body[static_cast<std::size_t>(hand)].linear(),
+                                 st1.T_world_body[static_cast<std::size_t>(hand)].linear()),
             0.5);
 }
 
@@ -159,7 +159,7 @@ TEST(HumanoidChain, PosesThatDisagreeWithTheJointAreNotValid) {
     MeasuredPoint& q = pts[static_cast<std::size_t>(p)];
     q.X_world = dR * (q.X_world - c_w) + c_w;
   }
-  h.solver.solve(pts.data(), static_cast<int>(pts.size()), kDt, poses, r);
+  h.solver.solve(pts.data(), static_cast<int>(pts.size()), kHumanoidDt, poses, r);
   const auto& hip = r.joints[static_cast<std::size_t>(h.joint("hip_l"))];
   EXPECT_TRUE(hip.inconsistent);
   EXPECT_EQ(hip.solved_by, client::SolvedBy::kNone);
@@ -178,8 +178,8 @@ TEST(HumanoidChain, SteadyStateAllocatesNothing) {
   ChainResult r;
   const sim::SceneState st = h.state(1.0);
   h.frame(st, std::vector<int>(nb, -1), std::vector<bool>(nb, true), pts, poses);
-  h.solver.solve(pts.data(), static_cast<int>(pts.size()), kDt, poses, r);
-  h.accept(poses, r, kDt);
+  h.solver.solve(pts.data(), static_cast<int>(pts.size()), kHumanoidDt, poses, r);
+  h.accept(poses, r, kHumanoidDt);
   std::vector<int> visible(nb, -1);
   std::vector<bool> found(nb, true);
   for (const char* b : {"forearm_l", "hand_l", "foot_r"}) {
@@ -189,8 +189,8 @@ TEST(HumanoidChain, SteadyStateAllocatesNothing) {
   h.frame(st, visible, found, pts, poses);
   test::AllocationScope scope;
   for (int i = 2; i < 30; ++i) {
-    h.solver.solve(pts.data(), static_cast<int>(pts.size()), i * kDt, poses, r);
-    h.accept(poses, r, i * kDt);
+    h.solver.solve(pts.data(), static_cast<int>(pts.size()), i * kHumanoidDt, poses, r);
+    h.accept(poses, r, i * kHumanoidDt);
   }
   EXPECT_EQ(scope.count(), 0u);
   EXPECT_EQ(r.joints[static_cast<std::size_t>(h.joint("wrist_l"))].solved_by,
