@@ -72,12 +72,14 @@ Expected<void> ReplayCamera::configure(const CameraConfig& want) {
 
 Expected<void> ReplayCamera::start() {
   if (auto r = check_configured(); !r) return r;
-  images_.assign(static_cast<std::size_t>(config_.buffer_count), Image{});
-  for (Image& im : images_) {
-    im.allocate(config_.width, config_.height, config_.format,
-                static_cast<std::uint16_t>(config_.format == PixelFormat::kMono8 ? 255 : 65535));
+  const auto buffers = static_cast<std::size_t>(config_.buffer_count);
+  mapped_.clear();
+  mapped_.resize(buffers);
+  images_.assign(buffers, Image{});
+  if (config_.format != PixelFormat::kMono8) {  // 16-bit: read (swapped) into owned images
+    for (Image& im : images_) im.allocate(config_.width, config_.height, config_.format, 65535);
   }
-  held_.assign(images_.size(), false);
+  held_.assign(buffers, false);
   next_ = 0;
   triggers_ = 0;
   reset_sequence();
@@ -126,20 +128,37 @@ CameraStatus ReplayCamera::dequeue(Frame& out, int timeout_ms) noexcept {
   }
   const FrameEntry& entry = frames[next_++];
   if (config_.trigger == TriggerMode::kSoftware) --triggers_;
-  Image& image = images_[b];
-  const Expected<FrameLoad> load = recording_->load_frame(camera_index_, entry.frame, image);
+  ImageView view{};
   bool missing = false;
-  if (!load.ok() || image.format() != config_.format) {
-    counters_.errors.add();  // malformed or wrong format: delivered as missing
-    missing = true;
-  } else if (*load == FrameLoad::kMissing) {
-    counters_.missing.add();
-    missing = true;
+  if (config_.format == PixelFormat::kMono8) {  // zero copy: the file mapped in place
+    const Expected<PgmMapResult> map =
+        recording_->map_frame(camera_index_, entry.frame, mapped_[b]);
+    if (!map.ok() || *map == PgmMapResult::kNeedsCopy) {
+      counters_.errors.add();  // malformed, or 16-bit: delivered as missing
+      missing = true;
+    } else if (*map == PgmMapResult::kMissing) {
+      counters_.missing.add();
+      missing = true;
+    } else {
+      view = mapped_[b].view();
+    }
+  } else {
+    Image& image = images_[b];
+    const Expected<FrameLoad> load = recording_->load_frame(camera_index_, entry.frame, image);
+    if (!load.ok() || image.format() != config_.format) {
+      counters_.errors.add();  // malformed or wrong format: delivered as missing
+      missing = true;
+    } else if (*load == FrameLoad::kMissing) {
+      counters_.missing.add();
+      missing = true;
+    } else {
+      view = image.view();
+    }
   }
   const auto sequence = static_cast<std::uint64_t>(entry.frame);
   note_sequence(sequence);
   held_[b] = true;
-  out.image = missing ? ImageView{} : image.view();
+  out.image = view;
   out.sequence = sequence;
   out.timestamp_ns = entry.timestamp_ns;  // the data's time: the recording's
   out.received_ns = monotonic_ns();
@@ -157,6 +176,7 @@ CameraStatus ReplayCamera::release(const Frame& frame) noexcept {
     return CameraStatus::kInvalidBuffer;
   }
   held_[frame.buffer_index] = false;
+  mapped_[frame.buffer_index].reset();  // munmap: the frame's file is not looked at again
   return CameraStatus::kOk;
 }
 

@@ -1,9 +1,13 @@
 // Design: the replay backend: one camera of a recording folder (formats/recording.h)
 // played back as a Camera, either at the recording's own timing (frame i is delivered
 // at start + timestamp_i - timestamp_0, CLOCK_MONOTONIC) or as fast as possible. Images
-// are read into a pool of buffer_count Images allocated at start(); the Frame views
-// one of them until release(). Frame sequence = the recording's frame number,
-// timestamp_ns = its timestamp_ns (the data's capture time, published unchanged),
+// of 8-bit recordings are mapped in place (Recording::map_frame, zero copy: the
+// detector reads the page cache; the capture thread only opens and maps the file, so
+// it does not hold up the detectors that share its core), 16-bit ones read into a pool
+// of buffer_count Images allocated at start(); the Frame views the mapping or the
+// Image until release() (which unmaps). A recording's files must not be truncated
+// while it is replayed (a mapped page that vanished would fault). Frame sequence = the recording's
+// frame number, timestamp_ns = its timestamp_ns (the data's capture time, published unchanged),
 // delivered_ns = the CLOCK_MONOTONIC instant dequeue delivered it (image loaded): the
 // origin of the live pipeline's latencies (hal::latency_origin_ns). A frame whose file
 // is absent (or malformed, or of the wrong pixel format) is delivered with missing =
@@ -50,7 +54,8 @@ class ReplayCamera final : public CameraBase {
   std::shared_ptr<const Recording> recording_;
   int camera_index_ = 0;
   ReplayPacing pacing_;
-  std::vector<Image> images_;
+  std::vector<MappedPgm> mapped_;  // per buffer: the mapped file (8-bit)
+  std::vector<Image> images_;      // per buffer: the read image (16-bit)
   std::vector<bool> held_;
   std::size_t next_ = 0;        // index into recording_->frames()
   std::uint64_t triggers_ = 0;  // software triggers not yet consumed
