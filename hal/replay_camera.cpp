@@ -72,14 +72,13 @@ Expected<void> ReplayCamera::configure(const CameraConfig& want) {
 
 Expected<void> ReplayCamera::start() {
   if (auto r = check_configured(); !r) return r;
-  const auto buffers = static_cast<std::size_t>(config_.buffer_count);
-  mapped_.clear();
-  mapped_.resize(buffers);
-  images_.assign(buffers, Image{});
-  if (config_.format != PixelFormat::kMono8) {  // 16-bit: read (swapped) into owned images
-    for (Image& im : images_) im.allocate(config_.width, config_.height, config_.format, 65535);
-  }
-  held_.assign(buffers, false);
+  ahead_.reset();  // a restart replays from the first frame
+  auto ahead =
+      ReplayReadAhead::start(recording_, camera_index_, config_.buffer_count, config_.format,
+                             "mocap-replay" + std::to_string(camera_index_));
+  if (!ahead) return make_error(name_, "start", ahead.error().message);
+  ahead_ = std::move(*ahead);
+  held_.assign(static_cast<std::size_t>(config_.buffer_count), false);
   next_ = 0;
   triggers_ = 0;
   reset_sequence();
@@ -91,6 +90,8 @@ Expected<void> ReplayCamera::start() {
 void ReplayCamera::stop() noexcept {
   if (state_ == CameraState::kStreaming) state_ = CameraState::kConfigured;
 }
+
+ReplayCamera::~ReplayCamera() = default;
 
 CameraStatus ReplayCamera::trigger() noexcept {
   if (state_ != CameraState::kStreaming) return CameraStatus::kNotStreaming;
@@ -120,50 +121,40 @@ CameraStatus ReplayCamera::dequeue(Frame& out, int timeout_ms) noexcept {
     }
     if (due > now) sleep_until_ns(due);
   }
-  std::size_t b = 0;
-  while (b < held_.size() && held_[b]) ++b;
-  if (b == held_.size()) {
+  std::size_t held = 0;
+  for (const bool h : held_) held += h ? 1 : 0;
+  if (held == held_.size()) {
     counters_.no_buffer.add();
     return CameraStatus::kNoBuffer;
   }
-  const FrameEntry& entry = frames[next_++];
-  if (config_.trigger == TriggerMode::kSoftware) --triggers_;
-  ImageView view{};
-  bool missing = false;
-  if (config_.format == PixelFormat::kMono8) {  // zero copy: the file mapped in place
-    const Expected<PgmMapResult> map =
-        recording_->map_frame(camera_index_, entry.frame, mapped_[b]);
-    if (!map.ok() || *map == PgmMapResult::kNeedsCopy) {
-      counters_.errors.add();  // malformed, or 16-bit: delivered as missing
-      missing = true;
-    } else if (*map == PgmMapResult::kMissing) {
-      counters_.missing.add();
-      missing = true;
-    } else {
-      view = mapped_[b].view();
-    }
-  } else {
-    Image& image = images_[b];
-    const Expected<FrameLoad> load = recording_->load_frame(camera_index_, entry.frame, image);
-    if (!load.ok() || image.format() != config_.format) {
-      counters_.errors.add();  // malformed or wrong format: delivered as missing
-      missing = true;
-    } else if (*load == FrameLoad::kMissing) {
-      counters_.missing.add();
-      missing = true;
-    } else {
-      view = image.view();
-    }
+  // The frame is loaded ahead (replay_read_ahead.h); a loader behind the replay is
+  // waited for within the timeout.
+  ReplayReadAhead::Loaded loaded;
+  if (!ahead_->wait_next(loaded, monotonic_ns() + (timeout_ms > 0 ? timeout_ns : 0))) {
+    counters_.timeouts.add();
+    return CameraStatus::kTimeout;
   }
+  const FrameEntry& entry = frames[loaded.frame_index];  // == next_: loaded in order
+  ++next_;
+  if (config_.trigger == TriggerMode::kSoftware) --triggers_;
+  bool missing = true;
+  if (loaded.status == ReplayReadAhead::Status::kError) {
+    counters_.errors.add();  // malformed or wrong format: delivered as missing
+  } else if (loaded.status == ReplayReadAhead::Status::kMissing) {
+    counters_.missing.add();
+  } else {
+    missing = false;
+  }
+  const std::uint32_t b = loaded.buffer;
   const auto sequence = static_cast<std::uint64_t>(entry.frame);
   note_sequence(sequence);
   held_[b] = true;
-  out.image = view;
+  out.image = missing ? ImageView{} : ahead_->image(b).view();
   out.sequence = sequence;
   out.timestamp_ns = entry.timestamp_ns;  // the data's time: the recording's
   out.received_ns = monotonic_ns();
   out.delivered_ns = out.received_ns;  // latencies start here (hal/camera.h, Frame)
-  out.buffer_index = static_cast<std::uint32_t>(b);
+  out.buffer_index = b;
   out.missing = missing;
   counters_.frames.add();
   return CameraStatus::kOk;
@@ -176,7 +167,7 @@ CameraStatus ReplayCamera::release(const Frame& frame) noexcept {
     return CameraStatus::kInvalidBuffer;
   }
   held_[frame.buffer_index] = false;
-  mapped_[frame.buffer_index].reset();  // munmap: the frame's file is not looked at again
+  ahead_->give_back(frame.buffer_index);
   return CameraStatus::kOk;
 }
 

@@ -1,13 +1,13 @@
 // Design: the replay backend: one camera of a recording folder (formats/recording.h)
 // played back as a Camera, either at the recording's own timing (frame i is delivered
 // at start + timestamp_i - timestamp_0, CLOCK_MONOTONIC) or as fast as possible. Images
-// of 8-bit recordings are mapped in place (Recording::map_frame, zero copy: the
-// detector reads the page cache; the capture thread only opens and maps the file, so
-// it does not hold up the detectors that share its core), 16-bit ones read into a pool
-// of buffer_count Images allocated at start(); the Frame views the mapping or the
-// Image until release() (which unmaps). A recording's files must not be truncated
-// while it is replayed (a mapped page that vanished would fault). Frame sequence = the recording's
-// frame number, timestamp_ns = its timestamp_ns (the data's capture time, published unchanged),
+// are read ahead of their delivery into a pool of buffer_count Images allocated at
+// start(), by a loader thread per camera (`mocap-replay<k>`, hal/replay_read_ahead.h), as a
+// camera's DMA fills its buffers: dequeue() hands out a loaded buffer without copying,
+// and the Frame views it until release(). A frame that is due but not loaded yet (the
+// disk behind the replay) is waited for within dequeue's timeout, then kTimeout, as a
+// camera whose frame has not arrived; none is skipped. Frame sequence = the recording's frame
+// number, timestamp_ns = its timestamp_ns (the data's capture time, published unchanged),
 // delivered_ns = the CLOCK_MONOTONIC instant dequeue delivered it (image loaded): the
 // origin of the live pipeline's latencies (hal::latency_origin_ns). A frame whose file
 // is absent (or malformed, or of the wrong pixel format) is delivered with missing =
@@ -27,6 +27,7 @@
 
 #include "formats/recording.h"
 #include "hal/camera_base.h"
+#include "hal/replay_read_ahead.h"
 
 namespace mocap::hal {
 
@@ -38,6 +39,7 @@ class ReplayCamera final : public CameraBase {
   static Expected<std::unique_ptr<ReplayCamera>> open(std::shared_ptr<const Recording> recording,
                                                       int camera_index, ReplayPacing pacing);
 
+  ~ReplayCamera() override;
   Expected<void> configure(const CameraConfig& config) override;
   Expected<void> start() override;
   void stop() noexcept override;
@@ -54,8 +56,7 @@ class ReplayCamera final : public CameraBase {
   std::shared_ptr<const Recording> recording_;
   int camera_index_ = 0;
   ReplayPacing pacing_;
-  std::vector<MappedPgm> mapped_;  // per buffer: the mapped file (8-bit)
-  std::vector<Image> images_;      // per buffer: the read image (16-bit)
+  std::unique_ptr<ReplayReadAhead> ahead_;  // from start(): the loaded frames
   std::vector<bool> held_;
   std::size_t next_ = 0;        // index into recording_->frames()
   std::uint64_t triggers_ = 0;  // software triggers not yet consumed

@@ -23,6 +23,8 @@ namespace mocap {
 namespace formats_detail {
 namespace {
 
+constexpr std::size_t kHeaderBufferBytes = 4096;
+
 class Fd {
  public:
   explicit Fd(int fd) noexcept : fd_(fd) {}
@@ -93,8 +95,28 @@ Error header_error(const char* path, const std::string& what) { return make_erro
 
 }  // namespace
 
-Expected<PgmHeader> parse_pgm_header(const char* path, const std::uint8_t* head, std::size_t n,
-                                     bool more_follows, int expected_width, int expected_height) {
+Expected<void> read_pgm_path(const char* path, int expected_width, int expected_height, Image& out,
+                             bool* missing_ok) {
+  // O_NONBLOCK: a FIFO or device in place of a frame file must fail, never block the
+  // replay (no effect on regular files).
+  Fd fd(::open(path, O_RDONLY | O_CLOEXEC | O_NONBLOCK));
+  if (fd.get() < 0) {
+    const int e = errno;
+    if (missing_ok != nullptr && e == ENOENT) {
+      *missing_ok = true;
+      return {};
+    }
+    return make_error(path, "cannot open", std::strerror(e));
+  }
+  if (missing_ok != nullptr) *missing_ok = false;
+  struct stat st {};
+  if (::fstat(fd.get(), &st) != 0) return make_error(path, "cannot open", std::strerror(errno));
+  if (S_ISDIR(st.st_mode)) return make_error(path, "cannot open", "is a directory");
+
+  std::uint8_t head[kHeaderBufferBytes];
+  const long n_read = read_fully(fd.get(), head, sizeof head);
+  if (n_read < 0) return make_error(path, "cannot read", std::strerror(errno));
+  const auto n = static_cast<std::size_t>(n_read);
   if (n == 0) return header_error(path, "empty file (expected a binary PGM, magic P5)");
   if (n < 2 || head[0] != 'P' || head[1] != '5') {
     if (n >= 2 && head[0] == 'P' && head[1] >= '0' && head[1] <= '9') {
@@ -112,9 +134,9 @@ Expected<PgmHeader> parse_pgm_header(const char* path, const std::uint8_t* head,
   for (int i = 0; i < 3; ++i) {
     const int r = cur.number(fields[i]);
     if (r == 1) {
-      if (more_follows) {
+      if (n == sizeof head) {
         return header_error(path, std::string("header longer than ") +
-                                      std::to_string(kPgmHeaderBufferBytes) + " bytes (at " +
+                                      std::to_string(kHeaderBufferBytes) + " bytes (at " +
                                       kNames[i] + ")");
       }
       return header_error(path, std::string("truncated header (no ") + kNames[i] + ")");
@@ -145,42 +167,6 @@ Expected<PgmHeader> parse_pgm_header(const char* path, const std::uint8_t* head,
                                   " differs from the rig's " + std::to_string(expected_width) +
                                   "x" + std::to_string(expected_height));
   }
-  PgmHeader h;
-  h.width = static_cast<int>(width);
-  h.height = static_cast<int>(height);
-  h.maxval = static_cast<std::uint16_t>(maxval);
-  h.header_bytes = header_bytes;
-  return h;
-}
-
-Expected<void> read_pgm_path(const char* path, int expected_width, int expected_height, Image& out,
-                             bool* missing_ok) {
-  // O_NONBLOCK: a FIFO or device in place of a frame file must fail, never block the
-  // replay (no effect on regular files).
-  Fd fd(::open(path, O_RDONLY | O_CLOEXEC | O_NONBLOCK));
-  if (fd.get() < 0) {
-    const int e = errno;
-    if (missing_ok != nullptr && e == ENOENT) {
-      *missing_ok = true;
-      return {};
-    }
-    return make_error(path, "cannot open", std::strerror(e));
-  }
-  if (missing_ok != nullptr) *missing_ok = false;
-  struct stat st {};
-  if (::fstat(fd.get(), &st) != 0) return make_error(path, "cannot open", std::strerror(errno));
-  if (S_ISDIR(st.st_mode)) return make_error(path, "cannot open", "is a directory");
-
-  std::uint8_t head[kPgmHeaderBufferBytes];
-  const long n_read = read_fully(fd.get(), head, sizeof head);
-  if (n_read < 0) return make_error(path, "cannot read", std::strerror(errno));
-  const auto n = static_cast<std::size_t>(n_read);
-  auto parsed = parse_pgm_header(path, head, n, n == sizeof head, expected_width, expected_height);
-  if (!parsed) return parsed.error();
-  const long width = parsed->width;
-  const long height = parsed->height;
-  const long maxval = parsed->maxval;
-  const std::size_t header_bytes = parsed->header_bytes;
   const PixelFormat format = maxval <= 255 ? PixelFormat::kMono8 : PixelFormat::kMono16;
   const std::size_t pixel_bytes = static_cast<std::size_t>(width) *
                                   static_cast<std::size_t>(height) *

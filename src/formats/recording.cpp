@@ -86,19 +86,7 @@ Expected<Recording> Recording::open(const std::string& dir) {
   return rec;
 }
 
-namespace {
-
-// "<dir>/<camera>/<frame, six digits>.pgm" into a stack buffer; false: too long.
-bool recording_frame_path(const std::string& dir, const std::string& camera, std::int64_t frame,
-                          char (&path)[4096]) noexcept {
-  const int len = std::snprintf(path, sizeof path, "%s/%s/%06lld.pgm", dir.c_str(), camera.c_str(),
-                                static_cast<long long>(frame));
-  return len >= 0 && static_cast<std::size_t>(len) < sizeof path;
-}
-
-}  // namespace
-
-Expected<void> Recording::check_frame(int camera_index, std::int64_t frame) const {
+Expected<FrameLoad> Recording::load_frame(int camera_index, std::int64_t frame, Image& out) const {
   if (camera_index < 0 || static_cast<std::size_t>(camera_index) >= rig_.cameras.size()) {
     return make_error(dir_, "",
                       "camera index " + std::to_string(camera_index) + " out of range (" +
@@ -107,29 +95,16 @@ Expected<void> Recording::check_frame(int camera_index, std::int64_t frame) cons
   if (frame < 0 || frame > 999999999) {
     return make_error(dir_, "", "frame number " + std::to_string(frame) + " out of range");
   }
-  return {};
-}
-
-Expected<FrameLoad> Recording::load_frame(int camera_index, std::int64_t frame, Image& out) const {
-  if (auto ok = check_frame(camera_index, frame); !ok) return ok.error();
   const CameraModel& cam = rig_.cameras[static_cast<std::size_t>(camera_index)];
   char path[4096];
-  if (!recording_frame_path(dir_, cam.name, frame, path))
+  const int len = std::snprintf(path, sizeof path, "%s/%s/%06lld.pgm", dir_.c_str(),
+                                cam.name.c_str(), static_cast<long long>(frame));
+  if (len < 0 || static_cast<std::size_t>(len) >= sizeof path) {
     return make_error(dir_, "", "frame path too long");
+  }
   bool missing = false;
   if (auto r = read_pgm_path(path, cam.width, cam.height, out, &missing); !r) return r.error();
   return missing ? FrameLoad::kMissing : FrameLoad::kOk;
-}
-
-Expected<PgmMapResult> Recording::map_frame(int camera_index, std::int64_t frame,
-                                            MappedPgm& out) const {
-  out.reset();
-  if (auto ok = check_frame(camera_index, frame); !ok) return ok.error();
-  const CameraModel& cam = rig_.cameras[static_cast<std::size_t>(camera_index)];
-  char path[4096];
-  if (!recording_frame_path(dir_, cam.name, frame, path))
-    return make_error(dir_, "", "frame path too long");
-  return map_pgm_path(path, cam.width, cam.height, out);
 }
 
 FrameSetLoader::FrameSetLoader(const Recording& rec)

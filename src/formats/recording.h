@@ -12,7 +12,6 @@
 #include "camera/camera_model.h"
 #include "core/expected.h"
 #include "core/image.h"
-#include "formats/pgm_map.h"
 
 namespace mocap {
 
@@ -67,12 +66,8 @@ class Recording {
   // nothing when `out` already has the rig's size and the frame's pixel format; safe to
   // call from several threads at once (each with its own Image).
   Expected<FrameLoad> load_frame(int camera_index, std::int64_t frame, Image& out) const;
-  // The same frame mapped in place (zero copy, pgm_map.h): kMapped, kMissing, or
-  // kNeedsCopy for a 16-bit file (then load_frame it); the same errors as load_frame.
-  Expected<PgmMapResult> map_frame(int camera_index, std::int64_t frame, MappedPgm& out) const;
 
  private:
-  Expected<void> check_frame(int camera_index, std::int64_t frame) const;
   std::string dir_;
   Rig rig_;
   std::vector<FrameEntry> frames_;

@@ -1,12 +1,10 @@
 // Tests of the PGM reader/writer: 8/16-bit round trips, header comments, every header
-// and data error (the zero-copy mapping rejects each with the same line), the size
-// check against the rig, and zero allocations when reading into an Image that already
-// has the right size.
+// and data error, the size check against the rig, and zero allocations when reading
+// into an Image that already has the right size.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "formats/pgm.h"
-#include "formats/pgm_map.h"
 #include "tests/support/alloc_counter.h"
 #include "tests/support/test_support.h"
 
@@ -29,16 +27,6 @@ class PgmTest : public ::testing::Test {
     if (r.ok()) return {};
     EXPECT_EQ(r.error().message.find('\n'), std::string::npos);
     EXPECT_THAT(r.error().message, StartsWith(path + ": "));
-    // The zero-copy path (pgm_map.h) rejects the same file with the same line, or
-    // leaves a 16-bit file to the reader.
-    MappedPgm mapped;
-    auto m = map_pgm_path(path.c_str(), 0, 0, mapped);
-    if (m.ok()) {
-      EXPECT_EQ(*m, PgmMapResult::kNeedsCopy) << r.error().message;
-    } else {
-      EXPECT_EQ(m.error().message, r.error().message);
-    }
-    EXPECT_FALSE(mapped.mapped());
     return r.error().message;
   }
 };

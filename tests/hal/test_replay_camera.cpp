@@ -159,10 +159,10 @@ TEST_F(ReplayFixture, SoftwareTriggerReleasesOneFrameEach) {
   EXPECT_EQ(cam->dequeue(f, 0), CameraStatus::kTimeout);
   ASSERT_EQ(cam->trigger(), CameraStatus::kOk);
   ASSERT_EQ(cam->trigger(), CameraStatus::kOk);
-  ASSERT_EQ(cam->dequeue(f, 0), CameraStatus::kOk);
+  ASSERT_EQ(cam->dequeue(f, 1000), CameraStatus::kOk);
   EXPECT_EQ(f.sequence, 0u);
   ASSERT_EQ(cam->release(f), CameraStatus::kOk);
-  ASSERT_EQ(cam->dequeue(f, 0), CameraStatus::kOk);
+  ASSERT_EQ(cam->dequeue(f, 1000), CameraStatus::kOk);
   EXPECT_EQ(f.sequence, 1u);
   EXPECT_EQ(cam->dequeue(f, 0), CameraStatus::kTimeout);
 }
@@ -170,14 +170,14 @@ TEST_F(ReplayFixture, SoftwareTriggerReleasesOneFrameEach) {
 TEST_F(ReplayFixture, BufferExhaustionAndBadRelease) {
   auto cam = camera(0, ReplayPacing::kAsFastAsPossible);
   Frame a, b, c;
-  ASSERT_EQ(cam->dequeue(a, 0), CameraStatus::kOk);
-  ASSERT_EQ(cam->dequeue(b, 0), CameraStatus::kOk);
+  ASSERT_EQ(cam->dequeue(a, 1000), CameraStatus::kOk);
+  ASSERT_EQ(cam->dequeue(b, 1000), CameraStatus::kOk);
   EXPECT_NE(a.image.data, b.image.data);
-  EXPECT_EQ(cam->dequeue(c, 0), CameraStatus::kNoBuffer);
+  EXPECT_EQ(cam->dequeue(c, 1000), CameraStatus::kNoBuffer);
   EXPECT_EQ(cam->counters().no_buffer.get(), 1u);
   ASSERT_EQ(cam->release(a), CameraStatus::kOk);
   EXPECT_EQ(cam->release(a), CameraStatus::kInvalidBuffer);
-  ASSERT_EQ(cam->dequeue(c, 0), CameraStatus::kOk);
+  ASSERT_EQ(cam->dequeue(c, 1000), CameraStatus::kOk);
   EXPECT_EQ(c.sequence, 2u);  // the frame is not lost by kNoBuffer
 }
 
@@ -205,11 +205,11 @@ TEST_F(ReplayFixture, ConfigurationErrors) {
 TEST_F(ReplayFixture, SteadyStateAllocatesNothing) {
   auto cam = camera(1, ReplayPacing::kAsFastAsPossible);
   Frame f;
-  ASSERT_EQ(cam->dequeue(f, 0), CameraStatus::kOk);  // warm-up
+  ASSERT_EQ(cam->dequeue(f, 1000), CameraStatus::kOk);  // warm-up
   ASSERT_EQ(cam->release(f), CameraStatus::kOk);
   mocap::test::AllocationScope scope;
   for (int i = 0; i < 2; ++i) {  // frames 1 and 2 (3 is missing: its error path may allocate)
-    ASSERT_EQ(cam->dequeue(f, 0), CameraStatus::kOk);
+    ASSERT_EQ(cam->dequeue(f, 1000), CameraStatus::kOk);
     ASSERT_EQ(cam->release(f), CameraStatus::kOk);
   }
   EXPECT_EQ(scope.count(), 0u);
