@@ -8,6 +8,11 @@
 // 16-bit) + cv::connectedComponentsWithStats + background-subtracted intensity-weighted
 // centroids per component over its bounding box. The stereo-frame case (2 x 1032x776,
 // 15 markers each) is the acceptance scene. Args: {width, height, markers, bits}.
+// BM_DetectScan compares the two scan strategies in one run on a tracking-like scene
+// (1280x1024 8-bit, 60 markers of 5-7 px diameter, tracker config): full_scan 0 = the
+// default two-pass scan, 1 = the reference full scan; images 1 = the same image every
+// iteration (cache-hot, as after a file read), 16 = cycling through 16 images (21 MB:
+// every detect reads its image from L3/DRAM, as in the live pipeline).
 #include <benchmark/benchmark.h>
 
 #include <cstring>
@@ -83,6 +88,47 @@ void BM_Detect(benchmark::State& state) {
   }
   state.counters["blobs"] = static_cast<double>(blobs.size());
   set_counters(state, s.image.view);
+}
+
+const SynthImage& tracking_scene(int w, int h, int markers, std::uint32_t seed) {
+  static std::map<std::tuple<int, int, int, std::uint32_t>, std::unique_ptr<SynthImage>> cache;
+  auto& slot = cache[{w, h, markers, seed}];
+  if (!slot) {
+    SynthParams p;
+    p.width = w;
+    p.height = h;
+    p.background_dn = 12;
+    p.noise_sigma_dn = 2;
+    p.blur_sigma_px = 0.5;
+    p.seed = seed;
+    const auto spots =
+        mocap::detect::test::random_discs(markers, p, 2.5, 3.5, 120, 230, 3.0, seed + 100);
+    slot = std::make_unique<SynthImage>(mocap::detect::test::render(spots, p));
+  }
+  return *slot;
+}
+
+void BM_DetectScan(benchmark::State& state) {
+  const int w = static_cast<int>(state.range(0)), h = static_cast<int>(state.range(1));
+  const int markers = static_cast<int>(state.range(2));
+  const int images = static_cast<int>(state.range(4));
+  std::vector<ImageView> views;
+  for (int i = 0; i < images; ++i) {
+    views.push_back(tracking_scene(w, h, markers, static_cast<std::uint32_t>(1 + i)).view);
+  }
+  DetectorConfig cfg = bench_config(8);
+  cfg.max_elongation = 1.3;  // as TrackerConfig
+  cfg.full_scan = state.range(3) != 0;
+  auto det = BlobDetector::create(cfg, w, h);
+  BlobList blobs = det->make_blob_list();
+  std::size_t k = 0;
+  for (auto _ : state) {
+    det->detect(views[k], blobs);
+    k = k + 1 == views.size() ? 0 : k + 1;
+    benchmark::DoNotOptimize(blobs.begin());
+  }
+  state.counters["blobs"] = static_cast<double>(blobs.size());
+  set_counters(state, views[0]);
 }
 
 // The floor: one plain read of every pixel.
@@ -261,6 +307,10 @@ void scene_args(benchmark::internal::Benchmark* b) {
 }
 
 BENCHMARK(BM_Detect)->Apply(scene_args);
+BENCHMARK(BM_DetectScan)
+    ->ArgsProduct({{1280}, {1024}, {60}, {0, 1}, {1, 16}})
+    ->ArgNames({"w", "h", "markers", "full_scan", "images"})
+    ->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_ReadFloor)->Apply(scene_args);
 BENCHMARK(BM_MemcpyFloor)->Apply(scene_args);
 #if MOCAP_BENCH_HAVE_OPENCV

@@ -4,6 +4,33 @@
 #include <algorithm>
 
 namespace mocap::detect {
+namespace {
+
+// Adds row[x], row[x + step], ... (x < x_end) to four interleaved histograms:
+// consecutive samples mostly hit the same background bin, and one histogram would
+// serialise every increment on that bin. Returns the number of samples.
+template <class T>
+int bg_sample_row(const T* row, int x, int x_end, int step, int shift, int max_bin,
+                  std::uint32_t* hist, int bins) noexcept {
+  std::uint32_t* const h0 = hist;
+  std::uint32_t* const h1 = hist + bins;
+  std::uint32_t* const h2 = hist + 2 * bins;
+  std::uint32_t* const h3 = hist + 3 * bins;
+  auto bin = [&](int xi) noexcept { return std::min(static_cast<int>(row[xi]) >> shift, max_bin); };
+  const int n = x < x_end ? (x_end - x + step - 1) / step : 0;
+  int i = 0;
+  for (; i + 4 <= n; i += 4, x += 4 * step) {
+    const int b0 = bin(x), b1 = bin(x + step), b2 = bin(x + 2 * step), b3 = bin(x + 3 * step);
+    ++h0[b0];
+    ++h1[b1];
+    ++h2[b2];
+    ++h3[b3];
+  }
+  for (; i < n; ++i, x += step) ++h0[bin(x)];
+  return n;
+}
+
+}  // namespace
 
 void BackgroundSampler::setup(int step_px) {
   step_px_ = std::max(step_px, 1);
@@ -25,47 +52,47 @@ double BackgroundSampler::percentile(double fraction, std::uint64_t total) const
   return static_cast<double>(maxval_);
 }
 
-// Four interleaved histograms: consecutive samples mostly hit the same background
-// bin, and one histogram would serialise every increment on that bin.
-template <class T>
-static std::uint64_t sample(const ImageView& img, const Roi& roi, int step_y, int step_x, int shift,
-                            std::uint32_t* hist, int bins) noexcept {
-  std::uint64_t n = 0;
-  const int max_bin = bins - 1;
-  const int y_first = roi.y + std::min(step_y / 2, (roi.height - 1) / 2);
-  const int x_first = roi.x + std::min(step_x / 2, (roi.width - 1) / 2);
-  for (int y = y_first; y < roi.y + roi.height; y += step_y) {
-    const T* row = reinterpret_cast<const T*>(img.row8(y));
-    int k = 0;
-    for (int x = x_first; x < roi.x + roi.width; x += step_x) {
-      const int b = std::min(static_cast<int>(row[x]) >> shift, max_bin);
-      ++hist[k * bins + b];
-      k = (k + 1) & 3;
-      ++n;
-    }
-  }
-  for (int b = 0; b < bins; ++b)
-    hist[b] += hist[bins + b] + hist[2 * bins + b] + hist[3 * bins + b];
-  return n;
-}
-
-BackgroundEstimate BackgroundSampler::estimate(const ImageView& img, const Roi& roi) noexcept {
+void BackgroundSampler::begin(const ImageView& img, const Roi& roi) noexcept {
   maxval_ = img.maxval;
   shift_ = 0;
   while ((static_cast<int>(maxval_) >> shift_) >= kMaxBins) ++shift_;
   bins_ = (static_cast<int>(maxval_) >> shift_) + 1;
   std::fill(hist_.begin(), hist_.begin() + 4 * bins_, 0u);
-  const int step_x = step_px_;
-  const std::uint64_t n =
-      img.format == PixelFormat::kMono8
-          ? sample<std::uint8_t>(img, roi, step_px_, step_x, shift_, hist_.data(), bins_)
-          : sample<std::uint16_t>(img, roi, step_px_, step_x, shift_, hist_.data(), bins_);
-  if (n == 0) return {};
+  y_first_ = roi.y + std::min(step_px_ / 2, (roi.height - 1) / 2);
+  x_first_ = roi.x + std::min(step_px_ / 2, (roi.width - 1) / 2);
+  x_end_ = roi.x + roi.width;
+  n_ = 0;
+}
+
+void BackgroundSampler::add_row(const ImageView& img, int y) noexcept {
+  const int max_bin = bins_ - 1;
+  const int n = img.format == PixelFormat::kMono8
+                    ? bg_sample_row(img.row8(y), x_first_, x_end_, step_px_, shift_, max_bin,
+                                    hist_.data(), bins_)
+                    : bg_sample_row(img.row16(y), x_first_, x_end_, step_px_, shift_, max_bin,
+                                    hist_.data(), bins_);
+  n_ += static_cast<std::uint64_t>(n);
+}
+
+BackgroundEstimate BackgroundSampler::finish() noexcept {
+  if (n_ == 0) return {};
+  // Fold the four interleaved histograms into the first.
+  std::uint32_t* const hist = hist_.data();
+  const int bins = bins_;
+  for (int b = 0; b < bins; ++b) {
+    hist[b] += hist[bins + b] + hist[2 * bins + b] + hist[3 * bins + b];
+  }
   BackgroundEstimate e;
-  e.level_dn = std::max(percentile(0.5, n), 0.0);
+  e.level_dn = std::max(percentile(0.5, n_), 0.0);
   // Lower half only: bright markers sit in the upper tail and must not inflate sigma.
-  e.noise_dn = std::max((e.level_dn - percentile(0.25, n)) / 0.6745, 0.0);
+  e.noise_dn = std::max((e.level_dn - percentile(0.25, n_)) / 0.6745, 0.0);
   return e;
+}
+
+BackgroundEstimate BackgroundSampler::estimate(const ImageView& img, const Roi& roi) noexcept {
+  begin(img, roi);
+  for (int y = y_first_; y < roi.y + roi.height; y += step_px_) add_row(img, y);
+  return finish();
 }
 
 }  // namespace mocap::detect

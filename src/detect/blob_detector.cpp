@@ -1,5 +1,6 @@
 // Design: setup (validation, workspace allocation) and the first half of the hot
-// path: threshold choice, the run scan with per-run moments and incremental
+// path: threshold choice, the run scan (two-pass: chunk maxima, then runs in the
+// bright chunks; or the full reference scan) with per-run moments and incremental
 // union-find labelling, and component resolution. Measuring the components is in
 // blob_measure.cpp. See blob_detector.h for the algorithm.
 #include "detect/blob_detector.h"
@@ -84,6 +85,8 @@ Expected<BlobDetector> BlobDetector::create(const DetectorConfig& cfg, int width
   d.height_ = height;
   d.roi_ = cfg.roi.width > 0 ? cfg.roi : Roi{0, 0, width, height};
   d.kernels_ = select_row_run_kernels(cfg.simd);
+  d.chunk_kernels_ = select_chunk_max_kernels(d.kernels_.level);
+  d.chunks_per_row_ = chunk_count(0, d.roi_.width, std::min(kChunkPx8, kChunkPx16));
   d.sampler_.setup(cfg.background_sample_step_px);
   const auto max_runs = static_cast<std::size_t>(cfg.max_runs);
   d.row_runs_.resize(static_cast<std::size_t>(d.roi_.width / 2 + 1));
@@ -92,14 +95,83 @@ Expected<BlobDetector> BlobDetector::create(const DetectorConfig& cfg, int width
   d.order_.resize(max_runs);
   d.row_span_.resize(static_cast<std::size_t>(d.roi_.height));
   d.profile_.resize(static_cast<std::size_t>(2 * (d.roi_.width + d.roi_.height) + 8));
+  if (!cfg.full_scan) {
+    d.chunk_max_.resize(static_cast<std::size_t>(d.chunks_per_row_) *
+                        static_cast<std::size_t>(d.roi_.height));
+    d.row_max_.resize(static_cast<std::size_t>(d.roi_.height));
+  }
   return d;
+}
+
+template <class T>
+void BlobDetector::summarise(const ImageView& img, bool sample_background) noexcept {
+  if (sample_background) sampler_.begin(img, roi_);
+  int next_sample = sample_background ? sampler_.first_row() : -1;
+  const int x0 = roi_.x;
+  const int x1 = roi_.x + roi_.width;
+  for (int i = 0; i < roi_.height; ++i) {
+    const int y = roi_.y + i;
+    const T* row = reinterpret_cast<const T*>(img.row8(y));
+    std::uint16_t* cm = chunk_max_.data() + static_cast<std::ptrdiff_t>(i) * chunks_per_row_;
+    if constexpr (sizeof(T) == 1) {
+      row_max_[i] = chunk_kernels_.k8(row, x0, x1, cm);
+    } else {
+      row_max_[i] = chunk_kernels_.k16(row, x0, x1, cm);
+    }
+    if (y == next_sample) {  // the row is in L1 now
+      sampler_.add_row(img, y);
+      next_sample += sampler_.step();
+    }
+  }
+}
+
+template <class T>
+int BlobDetector::row_kernel(const T* row, int x0, int x1, RowRun* out, int cap) const noexcept {
+  const auto thr = static_cast<std::uint16_t>(threshold_);
+  if constexpr (sizeof(T) == 1) {
+    return kernels_.k8(row, x0, x1, thr, out, cap);
+  } else {
+    return kernels_.k16(row, x0, x1, thr, out, cap);
+  }
+}
+
+// The runs of ROI row y from its bright chunks only: each maximal stretch of chunks
+// whose maximum reaches the threshold goes through the run kernel. The pixels on
+// either side of a stretch are dark (or outside the ROI), so these are exactly the
+// row's runs, in order; the return value follows the kernel's overflow convention.
+template <class T>
+int BlobDetector::bright_chunk_runs(const T* row, int y, int room) noexcept {
+  constexpr int kChunk = sizeof(T) == 1 ? kChunkPx8 : kChunkPx16;
+  const int i = y - roi_.y;
+  const auto thr = static_cast<std::uint16_t>(threshold_);
+  if (row_max_[i] < thr) return 0;
+  const std::uint16_t* cm = chunk_max_.data() + static_cast<std::ptrdiff_t>(i) * chunks_per_row_;
+  const int x0 = roi_.x;
+  const int x1 = roi_.x + roi_.width;
+  const int nc = chunk_count(x0, x1, kChunk);
+  int n = 0;
+  for (int c = 0; c < nc;) {
+    if (cm[c] < thr) {
+      ++c;
+      continue;
+    }
+    int e = c + 1;
+    while (e < nc && cm[e] >= thr) ++e;
+    const int a = x0 + c * kChunk;
+    const int b = std::min(x0 + e * kChunk, x1);
+    const int got = row_kernel(row, a, b, row_runs_.data() + n, room - n);
+    if (got > room - n) return room + 1;
+    n += got;
+    c = e;
+  }
+  return n;
 }
 
 template <class T>
 void BlobDetector::scan(const ImageView& img) noexcept {
   n_runs_ = 0;
   overflow_row_ = -1;
-  const auto thr = static_cast<std::uint16_t>(threshold_);
+  const bool two_pass = !cfg_.full_scan;
   const int x0 = roi_.x;
   const int x1 = roi_.x + roi_.width;
   const int row_cap = static_cast<int>(row_runs_.size());
@@ -108,12 +180,8 @@ void BlobDetector::scan(const ImageView& img) noexcept {
   for (int y = roi_.y; y < roi_.y + roi_.height; ++y) {
     const T* row = reinterpret_cast<const T*>(img.row8(y));
     const int room = std::min(cfg_.max_runs - n_runs_, row_cap);
-    int n = 0;
-    if constexpr (sizeof(T) == 1) {
-      n = kernels_.k8(row, x0, x1, thr, row_runs_.data(), room);
-    } else {
-      n = kernels_.k16(row, x0, x1, thr, row_runs_.data(), room);
-    }
+    int n = two_pass ? bright_chunk_runs(row, y, room)
+                     : row_kernel(row, x0, x1, row_runs_.data(), room);
     if (n > room) {
       overflow_row_ = y;
       n = room;
@@ -210,8 +278,16 @@ bool BlobDetector::detect(const ImageView& img, BlobList& out) noexcept {
   double noise = 0.0;
   double level = cfg_.background_dn;
   int thr = cfg_.threshold_dn;
-  if (cfg_.threshold_mode == ThresholdMode::kAdaptive) {
-    const BackgroundEstimate e = sampler_.estimate(img, roi_);
+  const bool adaptive = cfg_.threshold_mode == ThresholdMode::kAdaptive;
+  if (!cfg_.full_scan) {
+    if (img.format == PixelFormat::kMono8) {
+      summarise<std::uint8_t>(img, adaptive);
+    } else {
+      summarise<std::uint16_t>(img, adaptive);
+    }
+  }
+  if (adaptive) {
+    const BackgroundEstimate e = cfg_.full_scan ? sampler_.estimate(img, roi_) : sampler_.finish();
     level = e.level_dn;
     noise = e.noise_dn;
     const double above = std::max(cfg_.threshold_sigma * noise, double{1.0} * cfg_.min_contrast_dn);

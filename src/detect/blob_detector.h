@@ -3,10 +3,16 @@
 // is the hot path: noexcept, no allocation, no locks.
 //   1. threshold: fixed, or per frame from a sparse background histogram
 //      (background.h);
-//   2. one pass over the rows: SIMD kernels (row_runs.h) emit runs of bright pixels;
+//   2. a pass over the rows: SIMD kernels (row_runs.h) emit runs of bright pixels;
 //      each run's background-subtracted moments are summed while the row is in
 //      cache, and runs are united with the overlapping runs of the previous row
-//      (8-connectivity, union-find with the smaller index as root);
+//      (8-connectivity, union-find with the smaller index as root). By default this
+//      is the second of two passes: the first (chunk_max.h) reads every row once,
+//      before the threshold is known, keeping the maximum of each 128-byte chunk and
+//      giving the background histogram its sample rows on the way; the run kernels
+//      then read only chunks whose maximum reaches the threshold (still in cache).
+//      Dark chunks hold no bright pixel, so the runs are exactly those of a full
+//      scan (cfg.full_scan, kept as the reference);
 //   3. components are measured from their runs: area, bbox, peak, weighted centroid
 //      (optionally with the 1-pixel ring just below threshold), second-moment shape;
 //      filtered by size/border/elongation; merged markers flagged and split
@@ -24,6 +30,7 @@
 #include "core/image.h"
 #include "detect/background.h"
 #include "detect/blob.h"
+#include "detect/chunk_max.h"
 #include "detect/detector_config.h"
 #include "detect/row_runs.h"
 
@@ -67,6 +74,12 @@ class BlobDetector {
   BlobDetector() = default;
 
   template <class T>
+  void summarise(const ImageView& img, bool sample_background) noexcept;
+  template <class T>
+  int row_kernel(const T* row, int x0, int x1, RowRun* out, int cap) const noexcept;
+  template <class T>
+  int bright_chunk_runs(const T* row, int y, int room) noexcept;
+  template <class T>
   void scan(const ImageView& img) noexcept;
   void resolve_components() noexcept;
   template <class T>
@@ -83,6 +96,8 @@ class BlobDetector {
   int height_ = 0;
   Roi roi_{};
   RowRunKernels kernels_{};
+  ChunkMaxKernels chunk_kernels_{};
+  int chunks_per_row_ = 0;  // row stride of chunk_max_ (room for 16-bit chunks)
   BackgroundSampler sampler_;
   DetectorCounters counters_{};
 
@@ -93,12 +108,14 @@ class BlobDetector {
   int n_comps_ = 0;
   int overflow_row_ = -1;  // first row whose runs did not fit, -1 if none
 
-  std::vector<RowRun> row_runs_;     // one row's runs
-  std::vector<RunRec> runs_;         // max_runs
-  std::vector<CompAcc> comps_;       // max_runs
-  std::vector<std::int32_t> order_;  // max_runs: runs grouped by component
-  std::vector<RowRun> row_span_;     // ring: per-row span of one component
-  std::vector<double> profile_;      // split: profile along the major axis
+  std::vector<RowRun> row_runs_;          // one row's runs
+  std::vector<RunRec> runs_;              // max_runs
+  std::vector<CompAcc> comps_;            // max_runs
+  std::vector<std::int32_t> order_;       // max_runs: runs grouped by component
+  std::vector<RowRun> row_span_;          // ring: per-row span of one component
+  std::vector<double> profile_;           // split: profile along the major axis
+  std::vector<std::uint16_t> chunk_max_;  // two-pass scan: per ROI row and chunk
+  std::vector<std::uint16_t> row_max_;    // two-pass scan: per ROI row
 };
 
 }  // namespace mocap::detect

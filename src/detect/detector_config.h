@@ -62,6 +62,12 @@ struct DetectorConfig {
   int max_blobs = 512;   // BlobList capacity; more accepted blobs are dropped (counted)
   int max_runs = 32768;  // bright runs per frame; more stop the scan (counted)
   SimdLevel simd = SimdLevel::kAuto;
+  // Scan strategy; both give bit-identical blobs. false (default): two passes, one
+  // read of every row that records per-chunk maxima (and feeds the background
+  // histogram its sample rows), then run extraction in the chunks that reach the
+  // threshold only. true: the reference scan, a separate sparse read for the
+  // background estimate and then every row through the run kernel.
+  bool full_scan = false;
 };
 
 // One-line error naming the key, or success. width/height: the image size.

@@ -110,23 +110,6 @@ TEST(DetectRobustness, DamagedFramesNeverCrash) {
   }
 }
 
-// Field-by-field bit equality (padding bytes are not compared).
-bool same_blob(const Blob& a, const Blob& b) {
-  auto bits = [](auto v) {
-    std::uint64_t u = 0;
-    std::memcpy(&u, &v, sizeof v);
-    return u;
-  };
-  return bits(a.x_px) == bits(b.x_px) && bits(a.y_px) == bits(b.y_px) &&
-         bits(a.area_px) == bits(b.area_px) && bits(a.sum_dn) == bits(b.sum_dn) &&
-         a.peak_dn == b.peak_dn && a.background_dn == b.background_dn && a.x_min == b.x_min &&
-         a.x_max == b.x_max && a.y_min == b.y_min && a.y_max == b.y_max &&
-         bits(a.major_axis_px) == bits(b.major_axis_px) &&
-         bits(a.minor_axis_px) == bits(b.minor_axis_px) && bits(a.roundness) == bits(b.roundness) &&
-         bits(a.eccentricity) == bits(b.eccentricity) &&
-         bits(a.orientation_rad) == bits(b.orientation_rad) && a.flags == b.flags;
-}
-
 // Random scenes (bright shapes, noise, odd widths, padded strides, ROIs): every SIMD
 // level must give bit-identical blobs to the scalar kernel.
 TEST(DetectRobustness, SimdEqualsScalarExactly) {

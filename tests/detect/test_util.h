@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <vector>
 
 #include "detect/blob_detector.h"
@@ -56,6 +58,23 @@ inline MatchStats match(const std::vector<Spot>& spots, const BlobList& blobs,
   for (bool u : used) m.extra += u ? 0 : 1;
   m.rms_px = m.matched > 0 ? std::sqrt(sq / m.matched) : 0.0;
   return m;
+}
+
+// Field-by-field bit equality (padding bytes are not compared).
+inline bool same_blob(const Blob& a, const Blob& b) {
+  auto bits = [](auto v) {
+    std::uint64_t u = 0;
+    std::memcpy(&u, &v, sizeof v);
+    return u;
+  };
+  return bits(a.x_px) == bits(b.x_px) && bits(a.y_px) == bits(b.y_px) &&
+         bits(a.area_px) == bits(b.area_px) && bits(a.sum_dn) == bits(b.sum_dn) &&
+         a.peak_dn == b.peak_dn && a.background_dn == b.background_dn && a.x_min == b.x_min &&
+         a.x_max == b.x_max && a.y_min == b.y_min && a.y_max == b.y_max &&
+         bits(a.major_axis_px) == bits(b.major_axis_px) &&
+         bits(a.minor_axis_px) == bits(b.minor_axis_px) && bits(a.roundness) == bits(b.roundness) &&
+         bits(a.eccentricity) == bits(b.eccentricity) &&
+         bits(a.orientation_rad) == bits(b.orientation_rad) && a.flags == b.flags;
 }
 
 }  // namespace mocap::detect::test
