@@ -45,10 +45,18 @@ void make_joints_message(std::uint64_t sequence, std::int64_t capture_ns, const 
     q = client::JointQuality{};
     q.solved_by = static_cast<std::uint8_t>(a.valid ? a.solved_by : client::SolvedBy::kNone);
     for (std::size_t k = 0; k < 3; ++k) q.sd_rad[k] = static_cast<float>(a.sd_rad[k]);
+    client::JointRates& rt = msg.rates[j];
+    rt = client::JointRates{};
+    rt.valid = a.valid && a.rate_valid ? 1 : 0;
+    for (std::size_t k = 0; rt.valid && k < 3; ++k) {
+      rt.rate_rad_s[k] = static_cast<float>(a.rate_rad_s[k]);
+      rt.sd_rad_s[k] = static_cast<float>(a.rate_sd_rad_s[k]);
+    }
   }
   for (std::size_t j = n; j < client::kMaxJoints; ++j) {
     msg.joints[j] = client::JointRecord{};
     msg.quality[j] = client::JointQuality{};
+    msg.rates[j] = client::JointRates{};
   }
 }
 

@@ -28,12 +28,15 @@ inline constexpr int kMaxResultCameras = kMaxCameras;  // cameras with blobs
 inline constexpr int kMaxResultBlobs = 256;  // blobs per camera (= stereo max_points_per_camera)
 
 struct ResultBody {
-  std::uint8_t found = 0;    // 1: the body was found in this frame
-  std::uint8_t markers = 0;  // markers matched
-  std::uint8_t reserved[2] = {0, 0};
+  std::uint8_t found = 0;           // 1: the body was found in this frame
+  std::uint8_t markers = 0;         // markers matched
+  std::uint8_t velocity_valid = 0;  // 1: v_world_mm_s and w_world_rad_s are estimated
+  std::uint8_t reserved = 0;
   float rms_mm = 0.0f;                                       // residual of the fit
   std::array<double, 4> q_world_body{{1.0, 0.0, 0.0, 0.0}};  // qw, qx, qy, qz, qw >= 0
   std::array<double, 3> t_world_body_mm{{0.0, 0.0, 0.0}};
+  std::array<float, 3> v_world_mm_s{{0, 0, 0}};   // velocity of the body origin, world frame
+  std::array<float, 3> w_world_rad_s{{0, 0, 0}};  // angular velocity, world frame
 };
 
 struct ResultMarker {

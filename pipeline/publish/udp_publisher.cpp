@@ -8,6 +8,7 @@
 
 #include <cerrno>
 #include <cstring>
+#include <string>
 #include <utility>
 
 #include "client/udp_endpoint.h"
@@ -15,7 +16,14 @@
 namespace mocap::publish {
 
 Expected<UdpPublisher> UdpPublisher::create(const std::vector<std::string>& destinations,
-                                            const UdpMulticastOptions& multicast) {
+                                            const UdpMulticastOptions& multicast,
+                                            const std::vector<std::uint16_t>& versions) {
+  if (!versions.empty() && versions.size() != destinations.size())
+    return make_error("udp publisher", "versions", "one per destination");
+  for (const std::uint16_t v : versions) {
+    if (v != client::kDatagramVersion && v != client::kDatagramVersion2)
+      return make_error("udp publisher", "version " + std::to_string(v), "must be 1 or 2");
+  }
   std::vector<sockaddr_in> addrs;
   bool any_multicast = false;
   addrs.reserve(destinations.size());
@@ -47,7 +55,9 @@ Expected<UdpPublisher> UdpPublisher::create(const std::vector<std::string>& dest
     const int min_rcvbuf = 1;  // the kernel rounds up to its minimum
     (void)::setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &min_rcvbuf, sizeof min_rcvbuf);
   }
-  UdpPublisher pub(fd, std::move(addrs));  // owns fd from here
+  std::vector<std::uint16_t> vers = versions;
+  vers.resize(addrs.size(), client::kDatagramVersion);
+  UdpPublisher pub(fd, std::move(addrs), std::move(vers));  // owns fd from here
   if (any_multicast) {
     const auto set = [&](int option, const void* value, socklen_t len,
                          const char* what) -> Expected<void> {
@@ -69,12 +79,14 @@ Expected<UdpPublisher> UdpPublisher::create(const std::vector<std::string>& dest
   return pub;
 }
 
-UdpPublisher::UdpPublisher(int fd, std::vector<sockaddr_in> destinations) noexcept
-    : fd_(fd), destinations_(std::move(destinations)) {}
+UdpPublisher::UdpPublisher(int fd, std::vector<sockaddr_in> destinations,
+                           std::vector<std::uint16_t> versions) noexcept
+    : fd_(fd), destinations_(std::move(destinations)), versions_(std::move(versions)) {}
 
 UdpPublisher::UdpPublisher(UdpPublisher&& other) noexcept
     : fd_(std::exchange(other.fd_, -1)),
       destinations_(std::move(other.destinations_)),
+      versions_(std::move(other.versions_)),
       counters_(other.counters_) {}
 
 UdpPublisher& UdpPublisher::operator=(UdpPublisher&& other) noexcept {
@@ -82,6 +94,7 @@ UdpPublisher& UdpPublisher::operator=(UdpPublisher&& other) noexcept {
     if (fd_ >= 0) ::close(fd_);
     fd_ = std::exchange(other.fd_, -1);
     destinations_ = std::move(other.destinations_);
+    versions_ = std::move(other.versions_);
     counters_ = other.counters_;
   }
   return *this;
@@ -93,21 +106,33 @@ UdpPublisher::~UdpPublisher() {
 
 UdpPublisher::Status UdpPublisher::publish(const client::JointsMessage& msg) noexcept {
   ++counters_.messages;
-  const std::size_t size = client::encode_datagram(msg, buf_.data(), buf_.size());
-  if (size == 0) {
+  // Each version used is encoded once per message.
+  std::size_t size_v1 = 0, size_v2 = 0;
+  for (const std::uint16_t v : versions_) {
+    if (v == client::kDatagramVersion2 && size_v2 == 0)
+      size_v2 = client::encode_datagram(msg, buf_v2_.data(), buf_v2_.size(), v);
+    if (v == client::kDatagramVersion && size_v1 == 0)
+      size_v1 = client::encode_datagram(msg, buf_.data(), buf_.size(), v);
+  }
+  if (size_v1 == 0 && size_v2 == 0) {
     ++counters_.encode_failures;
     return Status::kFailed;
   }
   Status status = Status::kSent;
-  const auto send = [&](const sockaddr_in& dest) noexcept -> int {
-    const ssize_t n = ::sendto(fd_, buf_.data(), size, MSG_DONTWAIT | MSG_NOSIGNAL,
+  const auto send = [&](const sockaddr_in& dest, const std::uint8_t* data,
+                        std::size_t size) noexcept -> int {
+    const ssize_t n = ::sendto(fd_, data, size, MSG_DONTWAIT | MSG_NOSIGNAL,
                                reinterpret_cast<const sockaddr*>(&dest), sizeof(dest));
     return n == static_cast<ssize_t>(size) ? 0 : (n < 0 ? errno : EMSGSIZE);
   };
-  for (const sockaddr_in& dest : destinations_) {
-    int err = send(dest);
+  for (std::size_t i = 0; i < destinations_.size(); ++i) {
+    const sockaddr_in& dest = destinations_[i];
+    const bool v2 = versions_[i] == client::kDatagramVersion2;
+    const std::uint8_t* data = v2 ? buf_v2_.data() : buf_.data();
+    const std::size_t size = v2 ? size_v2 : size_v1;
+    int err = send(dest, data, size);
     const bool refused = err == ECONNREFUSED;
-    if (refused) err = send(dest);  // the report cleared the error: send this one
+    if (refused) err = send(dest, data, size);  // the report cleared the error: send this one
     if (err == 0) {
       ++counters_.datagrams_sent;
       if (refused) {

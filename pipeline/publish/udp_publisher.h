@@ -1,7 +1,8 @@
 // Design: tracker side of the UDP transport. create() resolves every "HOST:PORT"
 // destination once and opens ONE non-blocking IPv4 socket (never bound to a listening
-// port: the tracker sends only). publish() encodes datagram v1 into a preallocated
-// buffer and sendto()s each destination with MSG_DONTWAIT: noexcept, allocation-free,
+// port: the tracker sends only). publish() encodes the datagram (version 1, or 2 for the
+// destinations configured so) into preallocated buffers and sendto()s each destination
+// with MSG_DONTWAIT: noexcept, allocation-free,
 // no logging; transient errors (EAGAIN/ENOBUFS/ECONNREFUSED, ...) are only counted.
 // Multicast: when a destination is a multicast group (224.0.0.0/4), setup sets
 // IP_MULTICAST_TTL (hops, default 1: the local network), IP_MULTICAST_LOOP (default on:
@@ -41,8 +42,10 @@ struct UdpMulticastOptions {
 class UdpPublisher {
  public:
   // Fails with one line, e.g. "udp publisher: 'host:99999': port must be 0..65535".
+  // versions: the datagram version of each destination (1 or 2); empty: all version 1.
   static Expected<UdpPublisher> create(const std::vector<std::string>& destinations,
-                                       const UdpMulticastOptions& multicast = {});
+                                       const UdpMulticastOptions& multicast = {},
+                                       const std::vector<std::uint16_t>& versions = {});
 
   UdpPublisher(UdpPublisher&& other) noexcept;
   UdpPublisher& operator=(UdpPublisher&& other) noexcept;
@@ -65,12 +68,15 @@ class UdpPublisher {
   const UdpPublisherCounters& counters() const noexcept { return counters_; }
 
  private:
-  UdpPublisher(int fd, std::vector<sockaddr_in> destinations) noexcept;
+  UdpPublisher(int fd, std::vector<sockaddr_in> destinations,
+               std::vector<std::uint16_t> versions) noexcept;
 
   int fd_ = -1;
   std::vector<sockaddr_in> destinations_;  // fixed after create()
+  std::vector<std::uint16_t> versions_;    // per destination
   UdpPublisherCounters counters_{};
-  std::array<std::uint8_t, client::kMaxDatagramBytes> buf_{};
+  std::array<std::uint8_t, client::kMaxDatagramBytes> buf_{};     // version 1
+  std::array<std::uint8_t, client::kMaxDatagramBytes> buf_v2_{};  // version 2
 };
 
 }  // namespace mocap::publish

@@ -3,9 +3,11 @@
 // destination from the publish thread (sendto with MSG_DONTWAIT: never blocks). Counters
 // for other threads are rt::Counters of this sink (the transport's own are publish-thread
 // data). Registered as "udp": values = "HOST:PORT" destinations (none: no UDP output);
-// options multicast_if / multicast_ttl (the --multicast-* flags).
+// options multicast_if / multicast_ttl (the --multicast-* flags) and versions ("1,2,..."
+// one datagram version per destination, from the map form of outputs.udp; default 1).
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "pipeline/publish/output_registry.h"
 #include "pipeline/publish/udp_publisher.h"
@@ -41,7 +43,22 @@ class UdpSink final : public OutputSink {
   rt::Counter published_, failures_, no_listener_;
 };
 
+// "1,2,1" -> {1, 2, 1}; empty on a malformed list.
+std::vector<std::uint16_t> parse_versions(const std::string& text) {
+  std::vector<std::uint16_t> out;
+  for (std::size_t i = 0; i < text.size(); i += 2) {
+    if ((text[i] != '1' && text[i] != '2') || (i + 1 < text.size() && text[i + 1] != ','))
+      return {};
+    out.push_back(static_cast<std::uint16_t>(text[i] - '0'));
+  }
+  return out;
+}
+
 Expected<void> check_udp(const OutputRequest& r) {
+  if (const std::string* v = r.option("versions")) {
+    if (parse_versions(*v).size() != r.values.size())
+      return make_error(r.where, "versions '" + *v + "'", "expected 1 or 2 per destination");
+  }
   for (const std::string& d : r.values) {
     const std::size_t colon = d.rfind(':');
     bool ok = colon != std::string::npos && colon > 0 && colon + 1 < d.size() &&
@@ -68,7 +85,9 @@ Expected<OutputCreated> create_udp(const OutputRequest& r, const OutputContext&)
   UdpMulticastOptions mc;
   if (const std::string* i = r.option("multicast_if")) mc.interface = *i;
   if (const std::string* t = r.option("multicast_ttl")) mc.ttl = std::stoi(*t);
-  auto udp = UdpPublisher::create(r.values, mc);
+  std::vector<std::uint16_t> versions;
+  if (const std::string* v = r.option("versions")) versions = parse_versions(*v);
+  auto udp = UdpPublisher::create(r.values, mc, versions);
   if (!udp) return udp.error();
   out.sink = std::make_unique<UdpSink>(std::move(udp).value());
   return out;
@@ -77,7 +96,9 @@ Expected<OutputCreated> create_udp(const OutputRequest& r, const OutputContext&)
 }  // namespace
 
 extern const OutputKind kUdpOutput;
-const OutputKind kUdpOutput{"udp", "joint angles as UDP datagram v1 to HOST:PORT destinations",
-                            "multicast_if multicast_ttl", &check_udp, &create_udp};
+const OutputKind kUdpOutput{"udp",
+                            "joint angles as UDP datagrams (version 1, or 2 with quality and "
+                            "rates) to HOST:PORT destinations",
+                            "multicast_if multicast_ttl versions", &check_udp, &create_udp};
 
 }  // namespace mocap::publish

@@ -30,6 +30,7 @@ Expected<config::RunConfig> resolve_run_config(const std::string& path, const Cl
   if (cli.udp) {
     if (auto r = config::check_host_port("--udp", "", *cli.udp); !r) return r.error();
     cfg.outputs.udp = {*cli.udp};
+    cfg.outputs.udp_versions = {1};
   }
   if (cli.rate_hz) {
     if (auto r = config::check_trigger_rate_hz("--rate", *cli.rate_hz); !r) return r.error();
@@ -59,6 +60,12 @@ std::vector<publish::OutputRequest> output_requests(const config::RunConfig& cfg
   const std::string file = cfg.path.empty() ? std::string("outputs") : cfg.path + ": outputs";
   std::vector<publish::OutputRequest> v;
   publish::OutputRequest udp{"udp", cfg.outputs.udp, file + ".udp", {}};
+  std::string versions;  // "1,2,...": one per destination
+  for (std::size_t i = 0; i < cfg.outputs.udp.size(); ++i)
+    versions +=
+        (i ? "," : "") +
+        std::to_string(i < cfg.outputs.udp_versions.size() ? cfg.outputs.udp_versions[i] : 1);
+  if (!versions.empty()) udp.options.emplace_back("versions", versions);
   if (!cli.multicast_if.empty()) udp.options.emplace_back("multicast_if", cli.multicast_if);
   if (cli.multicast_ttl)
     udp.options.emplace_back("multicast_ttl", std::to_string(*cli.multicast_ttl));

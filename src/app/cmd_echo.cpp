@@ -7,11 +7,11 @@
 // joint's angles in degrees. --format csv prints a header and one row per joint and message (angles
 // in degrees, as the spec's CSV files), --format json one JSON object per message and line
 // (radians); both end with the joint's quality (solved_by and the standard deviations of the
-// angles; see docs/client.md) where the transport carries it (iceoryx; the UDP datagram v1 does
-// not: empty/null). --count / --duration stop it; SIGINT/SIGTERM stop it cleanly (the handler only
-// sets an atomic flag; RouDi also SIGTERMs its clients when it shuts down). A summary line goes to
-// stderr at the end. Setup failures (port in use, RouDi absent, bad address) are one line and exit
-// code 2.
+// angles; see docs/client.md) and its rates with their standard deviations, where the transport
+// carries them (iceoryx, UDP datagram v2; v1 does not: empty/null) and the rates are known. --count
+// / --duration stop it; SIGINT/SIGTERM stop it cleanly (the handler only sets an atomic flag; RouDi
+// also SIGTERMs its clients when it shuts down). A summary line goes to stderr at the end. Setup
+// failures (port in use, RouDi absent, bad address) are one line and exit code 2.
 #include <signal.h>
 #include <unistd.h>
 
@@ -24,6 +24,7 @@
 #include <thread>
 
 #include "app/command_registry.h"
+#include "client/datagram.h"
 #include "client/joints_message.h"
 #include "client/udp_receiver.h"
 #include "core/clock.h"
@@ -54,7 +55,8 @@ struct EchoArgs {
 
 constexpr const char* kCsvHeader =
     "seq,capture_ns,age_ms,gap,flags,joint,type,valid,a0_deg,a1_deg,a2_deg,qw,qx,qy,qz,"
-    "solved_by,sd0_deg,sd1_deg,sd2_deg";
+    "solved_by,sd0_deg,sd1_deg,sd2_deg,da0_deg_s,da1_deg_s,da2_deg_s,sd_da0_deg_s,sd_da1_deg_s,"
+    "sd_da2_deg_s";
 
 const char* solved_by_name(std::uint8_t s) {
   switch (static_cast<client::SolvedBy>(s)) {
@@ -75,12 +77,26 @@ void print_csv(const client::JointsMessage& m, std::uint64_t gap, double age_ms,
     const client::JointRecord& r = m.joints[j];
     const client::JointQuality& q = m.quality[j];
     const bool hinge = r.type == static_cast<std::uint8_t>(client::JointKind::kHinge);
-    char tail[128] = ",,,";
+    char tail[256] = ",,,,,,,,,";
     if (quality) {
-      std::snprintf(tail, sizeof tail, "%s,%.6f,%.6f,%.6f", solved_by_name(q.solved_by),
-                    static_cast<double>(q.sd_rad[0]) * kDegPerRad,
-                    static_cast<double>(q.sd_rad[1]) * kDegPerRad,
-                    static_cast<double>(q.sd_rad[2]) * kDegPerRad);
+      const int n =
+          std::snprintf(tail, sizeof tail, "%s,%.6f,%.6f,%.6f", solved_by_name(q.solved_by),
+                        static_cast<double>(q.sd_rad[0]) * kDegPerRad,
+                        static_cast<double>(q.sd_rad[1]) * kDegPerRad,
+                        static_cast<double>(q.sd_rad[2]) * kDegPerRad);
+      const client::JointRates& rt = m.rates[j];
+      const std::size_t used = n > 0 ? static_cast<std::size_t>(n) : 0;
+      if (rt.valid && used < sizeof tail) {
+        std::snprintf(tail + used, sizeof tail - used, ",%.4f,%.4f,%.4f,%.4f,%.4f,%.4f",
+                      static_cast<double>(rt.rate_rad_s[0]) * kDegPerRad,
+                      static_cast<double>(rt.rate_rad_s[1]) * kDegPerRad,
+                      static_cast<double>(rt.rate_rad_s[2]) * kDegPerRad,
+                      static_cast<double>(rt.sd_rad_s[0]) * kDegPerRad,
+                      static_cast<double>(rt.sd_rad_s[1]) * kDegPerRad,
+                      static_cast<double>(rt.sd_rad_s[2]) * kDegPerRad);
+      } else if (used < sizeof tail) {
+        std::snprintf(tail + used, sizeof tail - used, ",,,,,,");
+      }
     }
     std::printf("%llu,%lld,%.3f,%llu,%u,%u,%s,%u,%.6f,%.6f,%.6f,%.9f,%.9f,%.9f,%.9f,%s\n",
                 static_cast<unsigned long long>(m.sequence), static_cast<long long>(m.capture_ns),
@@ -128,7 +144,12 @@ void print_json(const client::JointsMessage& m, std::uint64_t gap, double age_ms
          (hinge ? "hinge" : "ball") + "\",\"valid\":" + (r.valid ? "true" : "false") +
          ",\"a_rad\":" + json_array(r.a, 3) + ",\"q\":" + json_array(r.q, 4) + ",\"solved_by\":" +
          (quality ? "\"" + std::string(solved_by_name(q.solved_by)) + "\"" : std::string("null")) +
-         ",\"sd_rad\":" + (quality ? json_array(q.sd_rad, 3) : std::string("null")) + "}";
+         ",\"sd_rad\":" + (quality ? json_array(q.sd_rad, 3) : std::string("null"));
+    const bool rates = quality && m.rates[j].valid;
+    s +=
+        ",\"rate_rad_s\":" + (rates ? json_array(m.rates[j].rate_rad_s, 3) : std::string("null")) +
+        ",\"rate_sd_rad_s\":" + (rates ? json_array(m.rates[j].sd_rad_s, 3) : std::string("null")) +
+        "}";
   }
   s += "]}\n";
   std::fputs(s.c_str(), stdout);
@@ -162,6 +183,16 @@ void print_message(const client::JointsMessage& m, std::uint64_t gap, const std:
                   static_cast<double>(r.a[0]) * kDegPerRad,
                   static_cast<double>(r.a[1]) * kDegPerRad,
                   static_cast<double>(r.a[2]) * kDegPerRad);
+    }
+    const client::JointRates& rt = m.rates[j];
+    if (quality && r.valid != 0 && rt.valid != 0) {  // the rates, deg/s
+      if (hinge) {
+        std::printf(" (%+.1f/s)", static_cast<double>(rt.rate_rad_s[0]) * kDegPerRad);
+      } else {
+        std::printf(" (%+.1f %+.1f %+.1f /s)", static_cast<double>(rt.rate_rad_s[0]) * kDegPerRad,
+                    static_cast<double>(rt.rate_rad_s[1]) * kDegPerRad,
+                    static_cast<double>(rt.rate_rad_s[2]) * kDegPerRad);
+      }
     }
   }
   std::printf(" deg\n");
@@ -198,7 +229,7 @@ int echo_udp(const EchoArgs& a) {
     const std::uint64_t gap = c.dropped_frames - last_dropped;
     last_accepted = c.accepted;
     last_dropped = c.dropped_frames;
-    print_message(rx->latest(), gap, a.format, false);
+    print_message(rx->latest(), gap, a.format, rx->latest_version() >= client::kDatagramVersion2);
     ++printed;
   }
   const client::ReceiverCounters& c = rx->counters();

@@ -7,16 +7,20 @@
 //   distance    --poses OUT/poses.csv --segments gt/segments.csv          (Table 1A)
 //   precision   --targets T --model M --poses OUT/poses.csv --angles OUT/angles.csv (1B)
 //   angles      --truth REC/gt --angles OUT/angles.csv [--series errors.csv]
+//   rates       --truth REC/gt --angles OUT/angles.csv   (joint rates and their sd; last
+//               row "all": every sample pooled)
 #include <cmath>
 #include <cstdio>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "app/command_registry.h"
 #include "formats/csv_outputs.h"
 #include "formats/joints_yaml.h"
 #include "formats/targets_yaml.h"
 #include "track/evaluation.h"
+#include "track/rate_evaluation.h"
 #include "track/truth.h"
 
 namespace mocap::app {
@@ -138,6 +142,30 @@ int run_angles(const EvaluateArgs& a) {
   return 0;
 }
 
+int run_rates(const EvaluateArgs& a) {
+  auto truth = load_ground_truth(a.truth);
+  if (!truth) return fail(truth.error().message);
+  auto angles = read_angles_csv(a.angles);
+  if (!angles) return fail(angles.error().message);
+  JointRateError all;
+  const auto errors = rate_errors(truth->angles, *angles, &all);
+  if (all.samples == 0)
+    return fail(a.angles + ": no rates (columns da0..sd_da2) at frames of the ground truth");
+  if (a.header) {
+    std::printf(
+        "| run | joint | samples | RMS rate error [deg/s] | max [deg/s] | RMS stated sd [deg/s] | "
+        "sd / RMS |\n| --- | --- | --- | --- | --- | --- | --- |\n");
+  }
+  std::vector<JointRateError> rows = errors;
+  rows.push_back(all);  // the last row: every sample pooled
+  for (const JointRateError& r : rows) {
+    std::printf("| %s | %s | %lld | %.3f | %.3f | %.3f | %.2f |\n", a.label.c_str(),
+                r.joint.c_str(), static_cast<long long>(r.samples), r.rms_deg_s, r.max_deg_s,
+                r.rms_sd_deg_s, r.sd_ratio);
+  }
+  return 0;
+}
+
 void register_evaluate(CLI::App& app, int& exit_code) {
   auto args = std::make_shared<EvaluateArgs>();
   CLI::App* cmd =
@@ -173,6 +201,12 @@ void register_evaluate(CLI::App& app, int& exit_code) {
                   "Write per-frame errors (frame,time_s,joint,error_deg)");
   common(ang);
   ang->callback([args, &exit_code] { exit_code = run_angles(*args); });
+  CLI::App* rates = cmd->add_subcommand(
+      "rates", "Joint-rate errors (angles.csv da0..da2) and their stated sd against ground truth");
+  rates->add_option("--truth", args->truth, "Ground-truth folder (REC/gt)")->required();
+  rates->add_option("--angles", args->angles, "Tracked angles.csv")->required();
+  common(rates);
+  rates->callback([args, &exit_code] { exit_code = run_rates(*args); });
 }
 
 const CommandRegistrar kEvaluateRegistrar(80, register_evaluate);

@@ -1,9 +1,9 @@
 // Design: the public, fixed-size message of joint angles that `mocap run` publishes
 // for every frame reaching the end of the pipeline, over iceoryx (service "mocap",
 // instance "tracker", event "joints": this struct is the payload) and UDP (the spec's
-// datagram v1 carries the same fields). Consumers include this header only; it depends
-// on nothing but <cstdint> and core/joint_type.h (the project's one joint type, installed
-// with it). Trivially copyable, no pointers (iceoryx requirement).
+// datagram v1 carries the angles, version 2 also the quality and the rates). Consumers include this
+// header only; it depends on nothing but <cstdint> and core/joint_type.h (the project's one joint
+// type, installed with it). Trivially copyable, no pointers (iceoryx requirement).
 #pragma once
 
 #include <cstdint>
@@ -55,6 +55,15 @@ struct JointQuality {
   float sd_rad[3] = {0.0f, 0.0f, 0.0f};  // standard deviation of a0, a1, a2 (radians)
 };
 
+// Per-joint rates (2027-01 extension): the live tracker's causal rates of a0..a2 and their
+// standard deviations (kinematics/joint_rates.h; a hinge uses index 0).
+struct JointRates {
+  std::uint8_t valid = 0;  // 1: rates known (the joint is valid and its filter warmed up)
+  std::uint8_t reserved[3] = {0, 0, 0};
+  float rate_rad_s[3] = {0.0f, 0.0f, 0.0f};
+  float sd_rad_s[3] = {0.0f, 0.0f, 0.0f};
+};
+
 struct JointsMessage {
   std::uint64_t sequence = 0;     // counts every triggered frame: a gap means drops
   std::int64_t capture_ns = 0;    // CLOCK_MONOTONIC, trigger of this frame
@@ -66,9 +75,12 @@ struct JointsMessage {
   // Appended by the 2026-12 extension (the layout above is unchanged): quality[j] belongs
   // to joints[j].
   JointQuality quality[kMaxJoints];
+  // Appended by the 2027-01 extension: rates[j] belongs to joints[j].
+  JointRates rates[kMaxJoints];
 };
 
 static_assert(sizeof(JointRecord) == 32, "the UDP joint record is 32 bytes");
 static_assert(sizeof(JointQuality) == 16, "JointQuality is 16 bytes");
+static_assert(sizeof(JointRates) == 28, "JointRates is 28 bytes");
 
 }  // namespace mocap::client

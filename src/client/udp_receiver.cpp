@@ -97,7 +97,7 @@ void UdpReceiver::handle(std::size_t len) noexcept {
     ++counters_.rejected[static_cast<std::size_t>(DecodeStatus::kBadLength)];
     return;
   }
-  const DecodeStatus status = decode_datagram(buf_.data(), len, scratch_);
+  const DecodeStatus status = decode_datagram(buf_.data(), len, scratch_, &scratch_version_);
   if (status != DecodeStatus::kOk) {
     ++counters_.rejected[static_cast<std::size_t>(status)];
     return;
@@ -114,6 +114,7 @@ void UdpReceiver::handle(std::size_t len) noexcept {
     }
   }
   latest_ = scratch_;
+  latest_version_ = scratch_version_;
   ++counters_.accepted;
 }
 

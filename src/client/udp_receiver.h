@@ -63,6 +63,8 @@ class UdpReceiver {
 
   bool has_message() const noexcept { return counters_.accepted > 0; }
   const JointsMessage& latest() const noexcept { return latest_; }
+  // The datagram version of latest() (1: its quality and rates are defaults; 2: carried).
+  std::uint16_t latest_version() const noexcept { return latest_version_; }
   const ReceiverCounters& counters() const noexcept { return counters_; }
 
  private:
@@ -76,6 +78,7 @@ class UdpReceiver {
   ReceiverCounters counters_{};
   JointsMessage latest_{};
   JointsMessage scratch_{};
+  std::uint16_t latest_version_ = 0, scratch_version_ = 0;
   std::array<std::uint8_t, kMaxDatagramBytes + 1> buf_{};
 };
 

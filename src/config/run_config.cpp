@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <numbers>
 
 #include "config/config_reader.h"
 #include "config/tracking_assets.h"
@@ -216,12 +217,23 @@ void read_outputs(const std::string& file, const YAML::Node& node, OutputSetting
     o.udp.clear();
     if (!list.IsNull()) {
       formats_detail::require_list(list, s.path("udp"));
+      o.udp_versions.clear();
       for (std::size_t i = 0; i < list.size(); ++i) {
         const std::string where = index_path(s.path("udp"), i);
-        const std::string v = formats_detail::get_string(list[i], where);
+        std::uint16_t version = 1;
+        YAML::Node item;  // reset(), never operator= (see above)
+        item.reset(list[i]);
+        if (list[i].IsMap()) {  // {value: HOST:PORT, version: 1 | 2}
+          const Section m(list[i], where, {"value", "version"});
+          if (!m.has("value")) fail(where, "the map form needs a 'value'" + line_suffix(list[i]));
+          if (const auto v = m.integer("version", 1, 2)) version = static_cast<std::uint16_t>(*v);
+          item.reset(m.node("value"));
+        }
+        const std::string v = formats_detail::get_string(item, where);
         const std::string problem = config_detail::host_port_problem(v);
-        if (!problem.empty()) fail(where, problem + line_suffix(list[i]));
+        if (!problem.empty()) fail(where, problem + line_suffix(item));
         o.udp.push_back(v);
+        o.udp_versions.push_back(version);
       }
     }
   }
@@ -310,14 +322,27 @@ void read_identification(const YAML::Node& node, IdentifyConfig& c) {
   set(c.max_points, s.integer("max_points", 3, kMaxPoints));
 }
 
+// The joint-rate filter (kinematics/joint_rates.h), in the units of its keys.
+void read_velocity(const YAML::Node& node, kinematics::RateFilterConfig& c) {
+  const Section s(node, "velocity",
+                  {"max_gap_ms", "warmup_frames", "jerk_psd_deg2_per_s5", "min_angle_sd_deg"});
+  constexpr double kRad = std::numbers::pi / 180.0;
+  if (const auto v = positive(s, "max_gap_ms", 60'000.0)) c.max_gap_s = *v * 1e-3;
+  set(c.warmup_observations, s.integer("warmup_frames", 1, 100));
+  if (const auto v = positive(s, "jerk_psd_deg2_per_s5", 1e12))
+    c.jerk_psd_rad2_s5 = *v * kRad * kRad;
+  if (const auto v = positive(s, "min_angle_sd_deg", 10.0)) c.min_angle_sd_rad = *v * kRad;
+}
+
 Expected<RunConfig> parse(const std::string& path, const YAML::Node& root) {
   RunConfig cfg;
   cfg.path = path;
   const std::string dir = fs::path(path).parent_path().string();
   const std::string base = dir.empty() ? std::string(".") : dir;
-  const Section top(root, "",
-                    {"version", "cameras", "rig", "targets", "model", "pipeline", "outputs",
-                     "detection", "stereo", "identification", "sim", "service", "fault_injection"});
+  const Section top(
+      root, "",
+      {"version", "cameras", "rig", "targets", "model", "pipeline", "outputs", "detection",
+       "stereo", "identification", "velocity", "sim", "service", "fault_injection"});
   (void)top.integer("version", 1, 1);  // the only version so far; checked for the future
   if (top.has("cameras")) read_cameras(top.node("cameras"), base, cfg);
   if (const auto v = top.text("rig")) cfg.rig_path = resolve(base, *v);
@@ -328,6 +353,7 @@ Expected<RunConfig> parse(const std::string& path, const YAML::Node& root) {
   read_detection(top.node("detection"), cfg.tracker.detect);
   read_stereo(top.node("stereo"), cfg.tracker.stereo);
   read_identification(top.node("identification"), cfg.tracker.identify);
+  read_velocity(top.node("velocity"), cfg.tracker.velocity);
   const Section sim(top.node("sim"), "sim", {"loop_frames", "scene", "cameras", "rig"});
   set(cfg.sim.loop_frames, sim.integer("loop_frames", kMinLoopFrames, kMaxLoopFrames));
   set(cfg.sim.scene,

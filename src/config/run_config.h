@@ -85,6 +85,9 @@ struct OutputEntry {
 
 struct OutputSettings {
   std::vector<std::string> udp = {"127.0.0.1:7755"};  // "HOST:PORT" each, may be empty
+  // The datagram version of each udp destination (1 or 2: the map form `{value: HOST:PORT,
+  // version: 2}`); same length as udp.
+  std::vector<std::uint16_t> udp_versions = {1};
   bool iceoryx = true;
   std::vector<OutputEntry> more;  // in file order
 };

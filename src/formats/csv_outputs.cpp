@@ -20,9 +20,10 @@ constexpr const char* kPointsHeader = "frame,x,y,z,reproj_px";
 constexpr const char* kPointsHeaderCameras = "frame,x,y,z,reproj_px,cameras";
 constexpr const char* kPosesHeader = "frame,timestamp_ns,body,qw,qx,qy,qz,tx,ty,tz,markers,rms_mm";
 constexpr const char* kAnglesHeader = "frame,timestamp_ns,joint,type,a0,a1,a2,qw,qx,qy,qz";
-// The header written: the spec's columns plus the 2026-12 extension columns at the end.
+// The header written: the spec's columns plus the 2026-12 and 2027-01 extension columns.
 constexpr const char* kAnglesHeaderWritten =
-    "frame,timestamp_ns,joint,type,a0,a1,a2,qw,qx,qy,qz,solved_by,sd_a0,sd_a1,sd_a2";
+    "frame,timestamp_ns,joint,type,a0,a1,a2,qw,qx,qy,qz,solved_by,sd_a0,sd_a1,sd_a2,"
+    "da0,da1,da2,sd_da0,sd_da1,sd_da2";
 
 Quat qw_positive(const Quat& q) noexcept {
   if (q.w() < 0.0) return Quat(-q.w(), -q.x(), -q.y(), -q.z());
@@ -91,12 +92,18 @@ void write_row(CsvFile& f, const PoseRow& r) noexcept {
 void write_row(CsvFile& f, const AngleRow& r) noexcept {
   if (!f.handle()) return;
   const Quat q = qw_positive(r.q_parent_child);
-  std::fprintf(f.handle(), "%lld,%lld,%s,%s,%.6f,%.6f,%.6f,%.9f,%.9f,%.9f,%.9f,%s,%.6f,%.6f,%.6f\n",
+  std::fprintf(f.handle(), "%lld,%lld,%s,%s,%.6f,%.6f,%.6f,%.9f,%.9f,%.9f,%.9f,%s,%.6f,%.6f,%.6f",
                static_cast<long long>(r.frame), static_cast<long long>(r.timestamp_ns),
                r.joint.c_str(), joint_type_name(r.type), r.angles_deg.x(), r.angles_deg.y(),
                r.angles_deg.z(), q.w(), q.x(), q.y(), q.z(),
                r.solved_by.empty() ? "none" : r.solved_by.c_str(), r.sd_deg.x(), r.sd_deg.y(),
                r.sd_deg.z());
+  if (r.has_rates) {
+    std::fprintf(f.handle(), ",%.4f,%.4f,%.4f,%.4f,%.4f,%.4f\n", r.rate_deg_s.x(), r.rate_deg_s.y(),
+                 r.rate_deg_s.z(), r.rate_sd_deg_s.x(), r.rate_sd_deg_s.y(), r.rate_sd_deg_s.z());
+  } else {
+    std::fputs(",,,,,,\n", f.handle());
+  }
 }
 
 Expected<std::vector<PointRow>> read_points_csv(const std::string& path) {
@@ -165,6 +172,11 @@ Expected<std::vector<AngleRow>> read_angles_csv(const std::string& path) {
       if (r.has_column(14)) {
         a.solved_by = std::string(r.text(11));
         a.sd_deg = Vec3(r.number(12), r.number(13), r.number(14));
+      }
+      if (r.has_column(20) && !r.field_empty(15)) {
+        a.has_rates = true;
+        a.rate_deg_s = Vec3(r.number(15), r.number(16), r.number(17));
+        a.rate_sd_deg_s = Vec3(r.number(18), r.number(19), r.number(20));
       }
       rows.push_back(std::move(a));
     }

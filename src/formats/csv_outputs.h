@@ -46,6 +46,11 @@ struct AngleRow {
   // written as "none" when empty). Files without them read as "" and 0.
   std::string solved_by;
   Vec3 sd_deg = Vec3::Zero();
+  // Extension columns (2027-01): da0,da1,da2 (deg/s, the live tracker's causal rates of
+  // a0..a2) and sd_da0,sd_da1,sd_da2, written empty while no rate is known.
+  bool has_rates = false;
+  Vec3 rate_deg_s = Vec3::Zero();
+  Vec3 rate_sd_deg_s = Vec3::Zero();
 };
 
 // A CSV file opened for writing; the header is written at open.

@@ -27,8 +27,10 @@ class CsvReader {
 
   // Whether the current row has this column (extension columns beyond the header's).
   bool has_column(std::size_t column) const noexcept { return column < fields_.size(); }
-  std::string_view text(std::size_t column) const;
-  double number(std::size_t column) const;  // finite
+  // Whether the current row's field is empty (an optional value left out); the column exists.
+  bool field_empty(std::size_t column) const noexcept { return fields_[column].empty(); }
+  std::string_view text(std::size_t column) const;  // non-empty
+  double number(std::size_t column) const;          // finite
   std::int64_t integer(std::size_t column) const;
 
  private:

@@ -17,7 +17,6 @@
 #include <vector>
 
 #include "client/joints_message.h"
-
 #include "core/expected.h"
 #include "core/types.h"
 #include "formats/joints_yaml.h"
@@ -39,6 +38,11 @@ struct JointAngle {
   // (track/chain_solver.h) fills both.
   client::SolvedBy solved_by = client::SolvedBy::kNone;
   std::array<double, 3> sd_rad{};
+  // The causal rates of a0..a2 and their standard deviations (rad/s; hinge: index 0), set
+  // by JointRateFilter (joint_rates.h); rate_valid is false while none is known.
+  bool rate_valid = false;
+  std::array<double, 3> rate_rad_s{};
+  std::array<double, 3> rate_sd_rad_s{};
 };
 
 struct JointAngles {

@@ -72,6 +72,11 @@ Expected<FrameProcessor> FrameProcessor::create(const Rig& rig, const TargetSet&
     auto chain = ChainSolver::create(std::move(chain_model).value(), cc);
     if (!chain) return Error{"chain tracking: " + chain.error().message};
     p.chain_.emplace(std::move(chain).value());
+    std::vector<JointType> types;
+    for (const JointSpec& j : model->joints) types.push_back(j.type);
+    auto rates = kinematics::JointRateFilter::create(config.velocity, types);
+    if (!rates) return rates.error();
+    p.rates_.emplace(std::move(rates).value());
   }
   p.warnings_ = p.identifier_.warnings();
   if (p.chain_) {
@@ -297,6 +302,7 @@ bool FrameProcessor::process_blobs(std::int64_t timestamp_ns, FrameOutput& out) 
       }
       chain_->remember(out.poses, timestamp_ns);
     }
+    if (rates_) rates_->update(timestamp_ns, out.angles);
   }
   out.times.angles = monotonic_ns() - t;
   return identified;
@@ -345,6 +351,7 @@ void FrameProcessor::reset() noexcept {
   identifier_.reset();
   selector_.reset();
   if (angles_) angles_->reset();
+  if (rates_) rates_->reset();
 }
 
 }  // namespace mocap

@@ -32,6 +32,7 @@
 #include "formats/targets_yaml.h"
 #include "identify/identifier.h"
 #include "kinematics/joint_angles.h"
+#include "kinematics/joint_rates.h"
 #include "stereo/multiview.h"
 #include "stereo/stereo_triangulator.h"
 #include "track/chain_solver.h"
@@ -67,6 +68,8 @@ struct TrackerConfig {
   // noise, confidence and angular speed bound are taken from `identify` at create() (one
   // source for each); the other keys are its own.
   ChainConfig chain{};
+  // The causal joint rates of every frame with a model (kinematics/joint_rates.h).
+  kinematics::RateFilterConfig velocity{};
 };
 
 // Wall-clock duration of each stage of one frame (ns). `detect` covers every camera.
@@ -106,7 +109,7 @@ class FrameProcessor {
   // Stages 2-4 on the blobs already in `out.blobs` (camera_present must be set).
   bool process_blobs(std::int64_t timestamp_ns, FrameOutput& out) noexcept;
 
-  // Forget temporal state (identification priors, hinge unwrapping).
+  // Forget temporal state (identification priors, hinge unwrapping, joint rates).
   void reset() noexcept;
 
   // Whether 3D point i of the last processed frame was measured from a partial marker
@@ -128,6 +131,10 @@ class FrameProcessor {
   const StereoCounters& stereo_counters() const noexcept { return stereo_total_; }
   const MultiViewCounters& multiview_counters() const noexcept { return merger_.counters(); }
   const IdentifyCounters& identify_counters() const noexcept { return identifier_.counters(); }
+  // Joint-rate filter counters; null without a model.
+  const kinematics::RateFilterCounters* rate_counters() const noexcept {
+    return rates_ ? &rates_->counters() : nullptr;
+  }
   // Chain-tracking counters; null without a model.
   const ChainCounters* chain_counters() const noexcept {
     return chain_ ? &chain_->counters() : nullptr;
@@ -162,6 +169,7 @@ class FrameProcessor {
   Identifier identifier_;
   std::optional<kinematics::JointAngleSolver> angles_;
   std::optional<ChainSolver> chain_;
+  std::optional<kinematics::JointRateFilter> rates_;
   ChainResult chain_result_;
   std::vector<std::string> warnings_;
   // Workspace, sized at create().

@@ -139,6 +139,10 @@ Expected<OfflineTrackResult> track_recording(const OfflineTrackOptions& opt) {
         else
           ++result.joint_poses[j];
         angle_row.sd_deg = Vec3(a.sd_rad[0], a.sd_rad[1], a.sd_rad[2]) * kDegPerRad;
+        angle_row.has_rates = a.rate_valid;
+        angle_row.rate_deg_s = Vec3(a.rate_rad_s[0], a.rate_rad_s[1], a.rate_rad_s[2]) * kDegPerRad;
+        angle_row.rate_sd_deg_s =
+            Vec3(a.rate_sd_rad_s[0], a.rate_sd_rad_s[1], a.rate_sd_rad_s[2]) * kDegPerRad;
         write_row(*angles_csv, angle_row);
         ++result.angle_rows;
       }

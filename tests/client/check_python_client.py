@@ -50,7 +50,7 @@ def offline_checks(mc):
         fail("decode joints %r" % (got.joints,))
     bad = {
         "magic": b"XCAP" + data[4:],
-        "version": data[:4] + b"\x02\x00" + data[6:],
+        "version": data[:4] + b"\x03\x00" + data[6:],
         "length": data[:-1],
         "crc": data[:50] + bytes([data[50] ^ 1]) + data[51:],
         "short": data[:10],
@@ -62,6 +62,30 @@ def offline_checks(mc):
         except mc.DecodeError as e:
             if e.reason != reason:
                 fail("corruption %s rejected as %s" % (reason, e.reason))
+    # Version 2: quality and rates per joint (72-byte records).
+    v2 = msg._replace(version=mc.VERSION_2, joints=(
+        joints[0]._replace(solved_by=1, sd=(0.001, 0.002, 0.003), rate_valid=True,
+                           rate=(1.5, -2.5, 0.25), rate_sd=(0.01, 0.02, 0.03)),
+        joints[1]._replace(solved_by=0)))
+    data2 = mc.encode(v2)
+    if len(data2) != 40 + 2 * 72 + 4 or data2[4] != 2:
+        fail("v2 encoded length %d" % len(data2))
+    got2 = mc.decode(data2)
+    r0 = got2.joints[0]
+    if (got2.version != 2 or r0.solved_by != 1 or not r0.rate_valid or abs(r0.rate[1] + 2.5) > 1e-6
+            or abs(r0.rate_sd[2] - 0.03) > 1e-7 or abs(r0.sd[0] - 0.001) > 1e-9
+            or got2.joints[1].rate_valid):
+        fail("v2 decode %r" % (got2,))
+    if got.version != 1 or got.joints[0].rate is not None:
+        fail("v1 decode carries no rates: %r" % (got,))
+    for reason, d in {"length": data2[:-1], "version": data2[:4] + b"\x03\x00" + data2[6:],
+                      "crc": data2[:100] + bytes([data2[100] ^ 4]) + data2[101:]}.items():
+        try:
+            mc.decode(d)
+            fail("v2 corruption %s was accepted" % reason)
+        except mc.DecodeError as e:
+            if e.reason != reason:
+                fail("v2 corruption %s rejected as %s" % (reason, e.reason))
     with mc.Receiver("127.0.0.1", 0) as rx:
         tx = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         for seq in (10, 11, 14, 14, 12):

@@ -200,9 +200,13 @@ TEST(Datagram, WrongFieldsWithValidCrcGiveTheirStatus) {
   refresh_crc(bad);
   EXPECT_EQ(decode_datagram(bad.data(), bad.size(), out), DecodeStatus::kBadMagic);
   bad = good;
-  bad[4] = 2;
+  bad[4] = 3;
   refresh_crc(bad);
   EXPECT_EQ(decode_datagram(bad.data(), bad.size(), out), DecodeStatus::kBadVersion);
+  bad = good;
+  bad[4] = 2;  // version 2 records are 72 bytes: these do not fit
+  refresh_crc(bad);
+  EXPECT_EQ(decode_datagram(bad.data(), bad.size(), out), DecodeStatus::kBadLength);
   bad = good;
   bad[6] = 3;  // J = 3 but 2 records
   refresh_crc(bad);

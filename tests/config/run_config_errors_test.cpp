@@ -33,7 +33,8 @@ struct ErrorCase {
 const ErrorCase kCases[] = {
     {"UnknownTopLevelKey", "detetcion: {}\n",
      "detetcion: unknown key (line 1); expected one of: version, cameras, rig, targets, model, "
-     "pipeline, outputs, detection, stereo, identification, sim, service, fault_injection"},
+     "pipeline, outputs, detection, stereo, identification, velocity, sim, service, "
+     "fault_injection"},
     {"UnknownCameraKey", "cameras: [{backend: sim, exposure: 3}, {backend: sim}]\n",
      "cameras[0].exposure: unknown key (line 1); expected one of: backend, device, format, width, "
      "height, exposure_us, gain, trigger, frame_rate_hz, buffers"},
@@ -163,6 +164,20 @@ const ErrorCase kCases[] = {
      "outputs.udp[0]: expected HOST:PORT, got '127.0.0.1' (line 1)"},
     {"UdpBadPort", "outputs: {udp: ['a:1', 'b:70000']}\n",
      "outputs.udp[1]: port must be in 1..65535, got 'b:70000' (line 1)"},
+    {"UdpVersionThree", "outputs: {udp: [{value: 'a:1', version: 3}]}\n",
+     "outputs.udp[0].version: must be in [1, 2], got 3 (line 1)"},
+    {"UdpMapWithoutValue", "outputs: {udp: [{version: 2}]}\n",
+     "outputs.udp[0]: the map form needs a 'value' (line 1)"},
+    {"UdpMapUnknownKey", "outputs: {udp: [{value: 'a:1', versoin: 2}]}\n",
+     "outputs.udp[0].versoin: unknown key (line 1); expected one of: value, version"},
+    {"UdpMapBadValue", "outputs: {udp: [{value: 'a', version: 2}]}\n",
+     "outputs.udp[0]: expected HOST:PORT, got 'a' (line 1)"},
+    {"VelocityUnknownKey", "velocity: {max_gap: 100}\n",
+     "velocity.max_gap: unknown key (line 1); expected one of: max_gap_ms, warmup_frames, "
+     "jerk_psd_deg2_per_s5, min_angle_sd_deg"},
+    {"VelocityGapZero", "velocity: {max_gap_ms: 0}\n", "velocity.max_gap_ms: must be > 0 (line 1)"},
+    {"VelocityWarmup", "velocity: {warmup_frames: 0}\n",
+     "velocity.warmup_frames: must be in [1, 100], got 0 (line 1)"},
     {"IceoryxNotABool", "outputs: {iceoryx: 1}\n",
      "outputs.iceoryx: expected true or false, got '1' (line 1)"},
     {"ThresholdMode", "detection: {threshold_mode: otsu}\n",

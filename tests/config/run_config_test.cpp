@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 
 #include "config/tracking_assets.h"
@@ -108,6 +109,29 @@ TEST(RunConfig, SimCameraCountAndDetectStages) {
   EXPECT_EQ(*cfg->pipeline.detect_camera[3].cpu, -1);
   EXPECT_EQ(*cfg->pipeline.detect_camera[3].ring_depth, 5u);
   EXPECT_FALSE(cfg->pipeline.detect_camera[2].cpu.has_value());
+}
+
+TEST(RunConfig, UdpMapFormChoosesTheDatagramVersionAndVelocityIsRead) {
+  TempDir dir("cfg_udpv2");
+  write_file(dir.file("m.yaml"),
+             "outputs: {udp: ['10.0.0.2:9000', {value: '127.0.0.1:7756', version: 2},\n"
+             "                {value: '127.0.0.1:7757', version: 1}]}\n"
+             "velocity: {max_gap_ms: 50, warmup_frames: 5, jerk_psd_deg2_per_s5: 2e5,\n"
+             "           min_angle_sd_deg: 0.05}\n");
+  auto cfg = load_run_config(dir.file("m.yaml"));
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  ASSERT_EQ(cfg->outputs.udp.size(), 3u);
+  EXPECT_EQ(cfg->outputs.udp[1], "127.0.0.1:7756");
+  EXPECT_EQ(cfg->outputs.udp_versions, (std::vector<std::uint16_t>{1, 2, 1}));
+  EXPECT_DOUBLE_EQ(cfg->tracker.velocity.max_gap_s, 0.05);
+  EXPECT_EQ(cfg->tracker.velocity.warmup_observations, 5);
+  EXPECT_NEAR(cfg->tracker.velocity.jerk_psd_rad2_s5, 2e5 * std::pow(M_PI / 180.0, 2), 1e-9);
+  EXPECT_NEAR(cfg->tracker.velocity.min_angle_sd_rad, 0.05 * M_PI / 180.0, 1e-12);
+  // The defaults: one v1 destination.
+  write_file(dir.file("d.yaml"), "sim: {loop_frames: 10}\n");
+  auto d = load_run_config(dir.file("d.yaml"));
+  ASSERT_TRUE(d) << d.error().message;
+  EXPECT_EQ(d->outputs.udp_versions, (std::vector<std::uint16_t>{1}));
 }
 
 TEST(RunConfig, EmptyUdpListDisablesUdp) {

@@ -58,6 +58,11 @@ std::vector<AngleRow> sample_angles() {
     r.q_parent_child = Quat(Eigen::AngleAxisd(2.5 * i, Vec3(0, 0.6, 0.8)));
     r.solved_by = i == 0 ? "" : (i % 2 ? "chain" : "poses");
     r.sd_deg = Vec3(0.25, 0.5, 0.125) * (i % 2 ? 1.0 : 0.5);
+    r.has_rates = i >= 2;  // rows 0 and 1: the filter is warming up (empty columns)
+    if (r.has_rates) {
+      r.rate_deg_s = Vec3(-123.4567, 8.25, 0.0) * (i % 2 ? 1.0 : 2.0);
+      r.rate_sd_deg_s = Vec3(1.5, 2.25, 3.125);
+    }
     rows.push_back(r);
   }
   return rows;
@@ -135,9 +140,12 @@ TEST_F(CsvOutputsTest, AnglesRoundTrip) {
   }
   const std::string text = test::read_file(path);
   EXPECT_THAT(text, HasSubstr("frame,timestamp_ns,joint,type,a0,a1,a2,qw,qx,qy,qz,solved_by,sd_a0,"
-                              "sd_a1,sd_a2\n0,5,shoulder,ball,-170.100000,45.000001,3.300000,"));
-  // The extension columns: how each angle was solved and its standard deviations.
-  EXPECT_THAT(text, HasSubstr(",chain,0.250000,0.500000,0.125000\n"));
+                              "sd_a1,sd_a2,da0,da1,da2,sd_da0,sd_da1,sd_da2\n0,5,shoulder,ball,"
+                              "-170.100000,45.000001,3.300000,"));
+  // The extension columns: how each angle was solved, its standard deviations and (2027-01)
+  // its rates with theirs, empty while unknown.
+  EXPECT_THAT(text, HasSubstr(",chain,0.250000,0.500000,0.125000,,,,,,\n"));
+  EXPECT_THAT(text, HasSubstr(",-123.4567,8.2500,0.0000,1.5000,2.2500,3.1250\n"));
   EXPECT_THAT(text, HasSubstr("\n1,6,elbow,hinge,12.345679,0.000000,0.000000,"));
   auto back = read_angles_csv(path);
   ASSERT_TRUE(back.ok()) << back.error().message;
@@ -149,6 +157,9 @@ TEST_F(CsvOutputsTest, AnglesRoundTrip) {
     EXPECT_EQ(b.joint, rows[i].joint);
     EXPECT_EQ(b.solved_by, rows[i].solved_by.empty() ? "none" : rows[i].solved_by);
     EXPECT_NEAR((b.sd_deg - rows[i].sd_deg).norm(), 0.0, 1e-6);
+    EXPECT_EQ(b.has_rates, rows[i].has_rates);
+    EXPECT_NEAR((b.rate_deg_s - rows[i].rate_deg_s).norm(), 0.0, 1e-4);
+    EXPECT_NEAR((b.rate_sd_deg_s - rows[i].rate_sd_deg_s).norm(), 0.0, 1e-4);
     EXPECT_EQ(b.type, rows[i].type);
     EXPECT_NEAR((b.angles_deg - rows[i].angles_deg).cwiseAbs().maxCoeff(), 0.0, 5e-7);
     EXPECT_GE(b.q_parent_child.w(), 0.0);

@@ -32,7 +32,8 @@ int fuzz_datagram(const std::uint8_t* data, std::size_t size) {
   out.reserved = 0xA5A5;
   for (JointRecord& j : out.joints) j.index = 0xA5A5;
   const JointsMessage untouched = out;
-  const DecodeStatus st = decode_datagram(buf.data(), buf.size(), out);
+  std::uint16_t version = 0;
+  const DecodeStatus st = decode_datagram(buf.data(), buf.size(), out, &version);
   fuzz_check(to_string(st) != nullptr, "status without a name");
   if (st != DecodeStatus::kOk) {
     fuzz_check(out.sequence == untouched.sequence && out.capture_ns == untouched.capture_ns &&
@@ -42,11 +43,12 @@ int fuzz_datagram(const std::uint8_t* data, std::size_t size) {
                "rejected datagram modified the output");
     return 0;
   }
-  fuzz_check(buf.size() == datagram_size(out.joint_count),
+  fuzz_check(version == kDatagramVersion || version == kDatagramVersion2, "accepted a version");
+  fuzz_check(buf.size() == datagram_size(out.joint_count, version),
              "accepted a datagram of the wrong length");
   fuzz_check(out.joint_count <= kMaxJoints, "accepted too many joints");
   std::uint8_t again[kMaxDatagramBytes];
-  const std::size_t n = encode_datagram(out, again, sizeof again);
+  const std::size_t n = encode_datagram(out, again, sizeof again, version);
   fuzz_check(n == buf.size(), "re-encoded size differs");
   JointsMessage back;
   fuzz_check(decode_datagram(again, n, back) == DecodeStatus::kOk, "re-encoded datagram rejected");
@@ -56,6 +58,9 @@ int fuzz_datagram(const std::uint8_t* data, std::size_t size) {
              "round trip changed the header");
   fuzz_check(std::memcmp(back.joints, out.joints, sizeof out.joints) == 0,
              "round trip changed the joints");
+  fuzz_check(std::memcmp(back.quality, out.quality, sizeof out.quality) == 0 &&
+                 std::memcmp(back.rates, out.rates, sizeof out.rates) == 0,
+             "round trip changed the quality or the rates");
   return 0;
 }
 

@@ -106,17 +106,20 @@ TEST(EchoCli, CsvFormatHasHeaderOneRowPerJointAndEmptyQualityOverUdp) {
   ASSERT_EQ(header.size(), 1u) << r.output;
   EXPECT_EQ(header[0],
             "seq,capture_ns,age_ms,gap,flags,joint,type,valid,a0_deg,a1_deg,a2_deg,qw,qx,qy,qz,"
-            "solved_by,sd0_deg,sd1_deg,sd2_deg");
+            "solved_by,sd0_deg,sd1_deg,sd2_deg,da0_deg_s,da1_deg_s,da2_deg_s,sd_da0_deg_s,"
+            "sd_da1_deg_s,sd_da2_deg_s");
   std::vector<std::string> rows;
   std::istringstream in(r.output);
   for (std::string line; std::getline(in, line);)
     if (!line.empty() && line[0] >= '0' && line[0] <= '9') rows.push_back(line);
   ASSERT_EQ(rows.size(), 4u) << r.output;  // 2 messages x 2 joints
-  for (const std::string& row : rows) EXPECT_EQ(std::count(row.begin(), row.end(), ','), 18) << row;
-  // Joint 0: ball, valid, a0 = 0.5 rad; UDP v1 carries no quality: empty last columns.
+  for (const std::string& row : rows) EXPECT_EQ(std::count(row.begin(), row.end(), ','), 24) << row;
+  // Joint 0: ball, valid, a0 = 0.5 rad; UDP v1 carries no quality and no rates: empty last
+  // columns.
   EXPECT_NE(rows[0].find(",0,ball,1,28.647890,0.000000,0.000000,1.000000000,"), std::string::npos)
       << rows[0];
-  EXPECT_TRUE(rows[0].ends_with(",,,,")) << rows[0];
+  EXPECT_TRUE(rows[0].ends_with(",1.000000000,0.000000000,0.000000000,0.000000000,,,,,,,,,,"))
+      << rows[0];
   EXPECT_NE(rows[1].find(",1,hinge,0,"), std::string::npos) << rows[1];
   EXPECT_NE(rows[2].find(",2,1,0,ball,"), std::string::npos) << rows[2];  // gap 2, flags 1
 }
@@ -131,7 +134,8 @@ TEST(EchoCli, JsonFormatIsOneObjectPerMessage) {
     EXPECT_NE(o.find("\"capture_ns\":1,"), std::string::npos) << o;
     EXPECT_NE(o.find("\"all_bodies_found\":true,\"joints\":[{\"index\":0,\"type\":\"ball\","
                      "\"valid\":true,\"a_rad\":[0.5,0,0],\"q\":[1,0,0,0],\"solved_by\":null,"
-                     "\"sd_rad\":null},{\"index\":1,\"type\":\"hinge\",\"valid\":false,"),
+                     "\"sd_rad\":null,\"rate_rad_s\":null,\"rate_sd_rad_s\":null},{\"index\":1,"
+                     "\"type\":\"hinge\",\"valid\":false,"),
               std::string::npos)
         << o;
   }

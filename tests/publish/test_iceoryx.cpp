@@ -1,8 +1,8 @@
 // Design: shared-memory round trip with a real iceoryx daemon. The suite starts
 // `iox-roudi -m off -c <small config>` as a child process once (iceoryx allows one
 // runtime per process, so every test here shares it), publishes JointsMessage through
-// IceoryxPublisher / the registry's iceoryx sink and takes it with IceoryxSubscriber. Each test body runs
-// in a forked child with its own iceoryx runtime that exits before RouDi stops: RouDi
+// IceoryxPublisher / the registry's iceoryx sink and takes it with IceoryxSubscriber. Each test
+// body runs in a forked child with its own iceoryx runtime that exits before RouDi stops: RouDi
 // sends SIGTERM to every still-registered process when it shuts down. Skipped, with the
 // reason, when iox-roudi is not installed or another RouDi already runs on the machine.
 // ctest runs these under RESOURCE_LOCK iceoryx (RouDi's names are machine-global). With
@@ -64,10 +64,10 @@ class IceoryxRoundTrip : public ::testing::Test {
     }
     dir_ = new mocap::test::TempDir("iox");
     const std::string config = dir_->file("roudi.toml");
-    // One mempool: chunks for JointsMessage (1056 B) plus iceoryx's chunk header.
+    // One mempool: chunks for JointsMessage (2464 B) plus iceoryx's chunk header.
     mocap::test::write_file(config,
                             "[general]\nversion = 1\n\n[[segment]]\n\n[[segment.mempool]]\n"
-                            "size = 2048\ncount = 64\n");
+                            "size = 4096\ncount = 64\n");
     const std::string log = dir_->file("roudi.log");
     pid_ = ::fork();
     if (pid_ == 0) {

@@ -3,7 +3,8 @@
 // reader written against the same ROS 2 IDL and ROS 2 names (rt/joint_states,
 // rt/tf, rt/robot_description; sensor_msgs::msg::dds_::JointState_ ...) receives and
 // checks every message: the DOF names of the URDF (hinge "J", ball "J_x/_y/_z"), the
-// positions equal to the datagram's float angles, invalid joints left out, one
+// positions equal to the datagram's float angles, the velocities its rates (NaN while
+// not known), invalid joints left out, one
 // transform per body found (parent "mocap", metres, x y z w), the stamp on
 // CLOCK_REALTIME. A reader that never takes does not slow publish() (drops counted).
 // DDS that cannot start gives one notice line and no sink (the tracker runs on). A
@@ -78,6 +79,12 @@ void fill(FrameResult& f, std::uint64_t seq) {
     f.joints.joints[0].a[k] = 0.1f * static_cast<float>(seq) + 0.01f * static_cast<float>(k);
   f.joints.joints[1].valid = seq % 3 == 0 ? 0 : 1;  // every third frame: elbow invalid
   f.joints.joints[1].a[0] = -0.5f + 0.001f * static_cast<float>(seq);
+  // Rates: the shoulder's known from frame 3 on, the elbow's always when valid.
+  f.joints.rates[0].valid = seq >= 3 ? 1 : 0;
+  for (int k = 0; k < 3; ++k)
+    f.joints.rates[0].rate_rad_s[k] = seq >= 3 ? 10.0f + static_cast<float>(k) : 0.0f;
+  f.joints.rates[1].valid = 1;
+  f.joints.rates[1].rate_rad_s[0] = -0.25f * static_cast<float>(seq);
   f.body_count = 3;
   for (int b = 0; b < 3; ++b) {
     f.bodies[b].found = (b == 2 && seq % 3 == 0) ? 0 : 1;
@@ -252,7 +259,17 @@ TEST(Ros2Output, ReaderReceivesEveryMessageWithRos2NamesAndValues) {
     const bool elbow = f.joints.joints[1].valid != 0;
     ASSERT_EQ(m.name._length, elbow ? 4u : 3u) << s;
     ASSERT_EQ(m.position._length, m.name._length);
-    EXPECT_EQ(m.velocity._length, 0u);
+    ASSERT_EQ(m.velocity._length, m.name._length);  // rad/s, NaN while not known
+    for (int k = 0; k < 3; ++k) {
+      if (s >= 3) {
+        EXPECT_EQ(m.velocity._buffer[k], 10.0 + k) << s;
+      } else {
+        EXPECT_TRUE(std::isnan(m.velocity._buffer[k])) << s;
+      }
+    }
+    if (elbow) {
+      EXPECT_EQ(m.velocity._buffer[3], static_cast<double>(-0.25f * static_cast<float>(s)));
+    }
     EXPECT_STREQ(m.name._buffer[0], "shoulder_x");
     EXPECT_STREQ(m.name._buffer[1], "shoulder_y");
     EXPECT_STREQ(m.name._buffer[2], "shoulder_z");

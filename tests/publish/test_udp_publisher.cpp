@@ -117,6 +117,37 @@ TEST(UdpPublisher, PublishAndReceiveAllocateNothing) {
   EXPECT_GT(rx.counters().datagrams, 0u);
 }
 
+TEST(UdpPublisher, EachDestinationGetsItsDatagramVersion) {
+  UdpReceiver v1 = receiver();
+  UdpReceiver v2 = receiver();
+  auto pub = UdpPublisher::create({loopback(v1), loopback(v2)}, {}, {1, 2});
+  ASSERT_TRUE(pub.ok()) << pub.error().message;
+  JointsMessage m = make_message(7);
+  m.quality[2].solved_by = 2;
+  m.quality[2].sd_rad[0] = 0.004f;
+  m.rates[2].valid = 1;
+  m.rates[2].rate_rad_s[0] = -1.25f;
+  m.rates[2].sd_rad_s[0] = 0.03f;
+  ASSERT_EQ(pub->publish(m), UdpPublisher::Status::kSent);
+  drain(v1, 1);
+  drain(v2, 1);
+  ASSERT_EQ(v1.counters().accepted, 1u);
+  ASSERT_EQ(v2.counters().accepted, 1u);
+  EXPECT_EQ(v1.latest_version(), 1);
+  EXPECT_EQ(v1.latest().rates[2].valid, 0);  // version 1 carries no rates
+  EXPECT_EQ(v2.latest_version(), 2);
+  EXPECT_EQ(v2.latest().quality[2].solved_by, 2);
+  EXPECT_EQ(v2.latest().rates[2].valid, 1);
+  EXPECT_EQ(v2.latest().rates[2].rate_rad_s[0], -1.25f);
+  EXPECT_EQ(v2.latest().rates[2].sd_rad_s[0], 0.03f);
+  for (int j = 0; j < 5; ++j) EXPECT_EQ(v2.latest().joints[j].a[0], m.joints[j].a[0]);
+  // Setup: one version per destination, each 1 or 2.
+  EXPECT_EQ(UdpPublisher::create({loopback(v1)}, {}, {1, 2}).error().message,
+            "udp publisher: versions: one per destination");
+  EXPECT_EQ(UdpPublisher::create({loopback(v1)}, {}, {3}).error().message,
+            "udp publisher: version 3: must be 1 or 2");
+}
+
 TEST(UdpPublisher, SetupErrorsAreOneLine) {
   auto p = UdpPublisher::create({"127.0.0.1:9000", "localhost"});
   ASSERT_FALSE(p.ok());

@@ -75,19 +75,20 @@ TEST(TrackCli, TracksAndCalibratesASimulatedRecording) {
     EXPECT_TRUE(std::filesystem::exists(tmp.file(std::string("out/") + f))) << f;
   }
   const std::string angles = test::read_file(tmp.file("out/angles.csv"));
-  // The spec's columns, then the 2026-12 extension columns (docs/chain.md).
-  EXPECT_EQ(angles.rfind(
-                "frame,timestamp_ns,joint,type,a0,a1,a2,qw,qx,qy,qz,solved_by,sd_a0,sd_a1,sd_a2\n", 0),
+  // The spec's columns, then the 2026-12 (docs/chain.md) and 2027-01 (docs/kinematics.md,
+  // "Joint rates") extension columns.
+  EXPECT_EQ(angles.rfind("frame,timestamp_ns,joint,type,a0,a1,a2,qw,qx,qy,qz,solved_by,sd_a0,sd_a1,"
+                         "sd_a2,da0,da1,da2,sd_da0,sd_da1,sd_da2\n",
+                         0),
             0u);
   EXPECT_NE(angles.find(",elbow,hinge,"), std::string::npos);
   EXPECT_NE(angles.find(",shoulder,ball,"), std::string::npos);
   // --config: the identification thresholds of a run configuration. Coverage mode
   // (min_whole_markers 0) reports at least the poses of the default.
   test::write_file(tmp.file("coverage.yaml"), "identification:\n  min_whole_markers: 0\n");
-  const test::RunResult cov =
-      test::run_mocap("track " + rec + " --targets " + rec + "/targets.yaml --model " +
-                      tmp.file("model.yaml") + " --out " + tmp.file("cov") + " --config " +
-                      tmp.file("coverage.yaml") + " --quiet");
+  const test::RunResult cov = test::run_mocap(
+      "track " + rec + " --targets " + rec + "/targets.yaml --model " + tmp.file("model.yaml") +
+      " --out " + tmp.file("cov") + " --config " + tmp.file("coverage.yaml") + " --quiet");
   ASSERT_EQ(cov.exit_code, 0) << cov.output;
   EXPECT_GE(count_lines(test::read_file(tmp.file("cov/poses.csv"))),
             count_lines(test::read_file(tmp.file("out/poses.csv"))));

@@ -4,7 +4,9 @@
 // message definitions in ROS 2's DDS names), in ROS 2's wire conventions:
 //   rt/joint_states  sensor_msgs::msg::dds_::JointState_  one entry per VALID joint DOF,
 //                    named as the URDF of `mocap calibrate --urdf` (ros2_mapping.h),
-//                    position in radians (the datagram's float angles, widened);
+//                    position in radians (the datagram's float angles, widened),
+//                    velocity in rad/s (the tracker's causal rates; NaN for a DOF
+//                    whose rate is not known yet, the two frames after it was found);
 //   rt/tf            tf2_msgs::msg::dds_::TFMessage_      one transform per body found,
 //                    frame_id "mocap", child_frame_id the body name, metres;
 //   rt/robot_description std_msgs::msg::dds_::String_     the URDF of the joint model,
@@ -19,6 +21,7 @@
 #include <dds/dds.h>
 
 #include <cstdlib>
+#include <limits>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -89,6 +92,9 @@ class Ros2Sink final : public QueuedSink {
       if (r.valid == 0) continue;
       name_ptrs_[n] = const_cast<char*>(dofs_[i].name.c_str());  // DDS only reads
       positions_[n] = static_cast<double>(r.a[d.component]);
+      const client::JointRates& rates = f.joints.rates[d.joint];
+      velocities_[n] = rates.valid ? static_cast<double>(rates.rate_rad_s[d.component])
+                                   : std::numeric_limits<double>::quiet_NaN();
       ++n;
     }
     if (n > 0) {
@@ -100,6 +106,8 @@ class Ros2Sink final : public QueuedSink {
       js.name._buffer = name_ptrs_.data();
       js.position._length = js.position._maximum = n;
       js.position._buffer = positions_.data();
+      js.velocity._length = js.velocity._maximum = n;
+      js.velocity._buffer = velocities_.data();
       if (const dds_return_t rc = dds_write(joint_states_, &js); rc < 0)
         throw std::runtime_error(dds_strretcode(rc));
     }
@@ -134,6 +142,7 @@ class Ros2Sink final : public QueuedSink {
   void build_buffers() {
     name_ptrs_.assign(dofs_.size() + 1, nullptr);
     positions_.assign(dofs_.size() + 1, 0.0);
+    velocities_.assign(dofs_.size() + 1, 0.0);
     transforms_.assign(bodies_.size() + 1, geometry_msgs_msg_dds__TransformStamped_{});
   }
 
@@ -160,6 +169,7 @@ class Ros2Sink final : public QueuedSink {
   std::vector<ros2::JointDof> dofs_;
   std::vector<char*> name_ptrs_;
   std::vector<double> positions_;
+  std::vector<double> velocities_;
   std::vector<geometry_msgs_msg_dds__TransformStamped_> transforms_;
   std::string urdf_;
   std::int64_t offset_ns_ = 0;

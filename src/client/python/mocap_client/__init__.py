@@ -1,8 +1,8 @@
 """mocap_client: receive the joint angles that `mocap run` publishes over UDP.
 
-Pure Python (standard library only). Decodes the UDP datagram version 1 of the mocap
-interface specification (little-endian header, 32-byte joint records, CRC-32 as zlib's
-crc32) and keeps the newest message, counting sequence gaps (frames dropped on the way)
+Pure Python (standard library only). Decodes the UDP datagrams versions 1 and 2 of the
+mocap interface specification (little-endian header, 32-byte joint records, or 72-byte
+records with quality and joint rates; CRC-32 as zlib's crc32) and keeps the newest message, counting sequence gaps (frames dropped on the way)
 and every rejected datagram by reason.
 
     from mocap_client import Receiver
@@ -14,10 +14,10 @@ and every rejected datagram by reason.
 
 `python3 -m mocap_client [--host H] [--port N] [--count N] [--duration S]` prints CSV.
 """
-from .datagram import (DecodeError, JointRecord, Message, VERSION, decode, encode,
+from .datagram import (DecodeError, JointRecord, Message, VERSION, VERSION_2, decode, encode,
                        HINGE, BALL)
 from .receiver import Counters, Receiver
 
-__all__ = ["BALL", "HINGE", "VERSION", "Counters", "DecodeError", "JointRecord", "Message",
+__all__ = ["BALL", "HINGE", "VERSION", "VERSION_2", "Counters", "DecodeError", "JointRecord", "Message",
            "Receiver", "decode", "encode"]
-__version__ = "1.0.0"
+__version__ = "1.1.0"
