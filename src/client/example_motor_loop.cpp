@@ -1,15 +1,19 @@
 // Design: an example motor-controller loop consuming `mocap run` output. Every ~1 ms it
 // takes the newest joint angles (UDP, plus iceoryx when built with it and RouDi runs),
-// and twice a second prints the angles (degrees) and the drop counters. A real controller
-// would run its control law where the print is. Everything after setup is allocation-free
+// predicts them to the tick's own CLOCK_MONOTONIC instant (client/predict.h: needs the
+// rates of iceoryx or UDP datagram version 2), and twice a second prints the angles
+// (degrees), the prediction and the counters. A real controller would run its control law
+// where the prediction is used. Everything after setup is allocation-free
 // except the periodic printing.
 //   mocap_client_example [BIND_HOST:PORT=127.0.0.1:9870] [SECONDS=10] [--iceoryx]
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <string>
 
+#include "client/predict.h"
 #include "client/udp_receiver.h"
 #ifdef MOCAP_CLIENT_HAVE_ICEORYX
 #include "client/iceoryx_subscriber.h"
@@ -93,6 +97,9 @@ int main(int argc, char** argv) {
 #endif
 
   mocap::client::JointsMessage shm_msg;
+  bool have_shm = false;
+  mocap::client::JointPrediction prediction;
+  unsigned long long predicted = 0, refused = 0;  // ticks predicted / beyond the horizon
   const auto start = std::chrono::steady_clock::now();
   auto next_print = start + std::chrono::milliseconds(500);
   const auto end = start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
@@ -103,12 +110,31 @@ int main(int argc, char** argv) {
 #ifdef MOCAP_CLIENT_HAVE_ICEORYX
     if (shm) shm_new = shm->take_latest(shm_msg);
 #endif
-    // control law goes here, using receiver->latest() or shm_msg
+    have_shm = have_shm || shm_new;
+    // The state at this tick's instant (steady_clock is CLOCK_MONOTONIC on Linux).
     const auto now = std::chrono::steady_clock::now();
+    const std::int64_t now_ns =
+        std::chrono::duration_cast<std::chrono::nanoseconds>(now.time_since_epoch()).count();
+    const mocap::client::JointsMessage* latest =
+        have_shm ? &shm_msg : (receiver->has_message() ? &receiver->latest() : nullptr);
+    if (latest) {
+      if (mocap::client::predict(*latest, now_ns, prediction) ==
+          mocap::client::PredictStatus::kOk) {
+        ++predicted;  // control law goes here, using prediction.joints[j].a_rad / sd_rad
+      } else {
+        ++refused;  // the newest message is too old: hold or stop the motors
+      }
+    }
     if (now >= next_print) {
       next_print = now + std::chrono::milliseconds(500);
       if (receiver->has_message()) print_message("udp", receiver->latest());
       if (shm_new) print_message("shm", shm_msg);
+      if (predicted > 0 && prediction.joint_count > 0 && prediction.joints[0].valid) {
+        std::printf("predicted +%.1f ms: joint 0 a0 %.3f deg (sd %.3f)\n", prediction.dt_s * 1e3,
+                    static_cast<double>(prediction.joints[0].a_rad[0] * kDegPerRad),
+                    static_cast<double>(prediction.joints[0].sd_rad[0] * kDegPerRad));
+      }
+      std::printf("ticks predicted %llu, refused (beyond the horizon) %llu\n", predicted, refused);
       const auto& c = receiver->counters();
       std::printf(
           "udp: accepted %llu, dropped frames %llu, rejected %llu (crc %llu, length %llu), "

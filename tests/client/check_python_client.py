@@ -15,6 +15,7 @@
 import argparse
 import csv
 import io
+import math
 import os
 import socket
 import subprocess
@@ -76,6 +77,18 @@ def offline_checks(mc):
             or abs(r0.rate_sd[2] - 0.03) > 1e-7 or abs(r0.sd[0] - 0.001) > 1e-9
             or got2.joints[1].rate_valid):
         fail("v2 decode %r" % (got2,))
+    # predict(): joint 0 moves with its rates, joint 1 (no rates) is not predicted.
+    p = mc.predict(got2, got2.capture_ns + 10_000_000)
+    a0 = got2.joints[0].a[0] + 1.5 * 0.010
+    if (not p.joints[0].predicted or abs(p.joints[0].a[0] - a0) > 1e-6
+            or abs(p.joints[0].sd[2] - math.hypot(0.003, 0.03 * 0.010)) > 1e-7
+            or p.joints[1].predicted or abs(p.dt_s - 0.010) > 1e-12):
+        fail("predict %r" % (p,))
+    try:
+        mc.predict(got2, got2.capture_ns + 60_000_000)
+        fail("predict beyond the horizon was accepted")
+    except mc.BeyondHorizon:
+        pass
     if got.version != 1 or got.joints[0].rate is not None:
         fail("v1 decode carries no rates: %r" % (got,))
     for reason, d in {"length": data2[:-1], "version": data2[:4] + b"\x03\x00" + data2[6:],

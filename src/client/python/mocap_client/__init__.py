@@ -12,12 +12,16 @@ and every rejected datagram by reason.
             msg = rx.latest()
             print(msg.sequence, rx.age_s(), [j.a for j in msg.joints if j.valid])
 
+predict(msg, time.monotonic_ns()) extrapolates a version-2 message to now (predict.py).
+
 `python3 -m mocap_client [--host H] [--port N] [--count N] [--duration S]` prints CSV.
 """
 from .datagram import (DecodeError, JointRecord, Message, VERSION, VERSION_2, decode, encode,
                        HINGE, BALL)
+from .predict import BeyondHorizon, Prediction, PredictedJoint, predict
 from .receiver import Counters, Receiver
 
-__all__ = ["BALL", "HINGE", "VERSION", "VERSION_2", "Counters", "DecodeError", "JointRecord", "Message",
-           "Receiver", "decode", "encode"]
+__all__ = ["BALL", "HINGE", "VERSION", "VERSION_2", "BeyondHorizon", "Counters", "DecodeError",
+           "JointRecord", "Message", "PredictedJoint", "Prediction", "Receiver", "decode", "encode",
+           "predict"]
 __version__ = "1.1.0"
