@@ -17,7 +17,7 @@ namespace {
 
 using namespace mocap::client;
 
-JointsMessage random_message(std::mt19937& rng, std::uint16_t joints) {
+JointsMessage random_v2_message(std::mt19937& rng, std::uint16_t joints) {
   std::uniform_real_distribution<float> value(-3.0f, 3.0f);
   JointsMessage m;
   m.sequence = rng();
@@ -47,7 +47,7 @@ std::vector<std::uint8_t> encode(const JointsMessage& m, std::uint16_t version) 
   return buf;
 }
 
-void refresh_crc(std::vector<std::uint8_t>& b) {
+void refresh_v2_crc(std::vector<std::uint8_t>& b) {
   const std::size_t body = b.size() - 4;
   const std::uint32_t c = crc32_ieee(b.data(), body);
   for (int i = 0; i < 4; ++i)
@@ -114,7 +114,7 @@ TEST(DatagramV2, ByteLayoutOfOneJointMessage) {
 TEST(DatagramV2, RoundTripForEveryJointCountReportsTheVersion) {
   std::mt19937 rng(11);
   for (std::uint16_t j = 0; j <= kMaxJoints; ++j) {
-    const JointsMessage m = random_message(rng, j);
+    const JointsMessage m = random_v2_message(rng, j);
     for (const std::uint16_t version : {kDatagramVersion, kDatagramVersion2}) {
       const auto bytes = encode(m, version);
       ASSERT_EQ(bytes.size(), datagram_size(j, version));
@@ -150,7 +150,7 @@ TEST(DatagramV2, UnknownVersionIsNotEncoded) {
 
 TEST(DatagramV2, CorruptionsAreRejectedAndTheOutputUntouched) {
   std::mt19937 rng(12);
-  const JointsMessage m = random_message(rng, 3);
+  const JointsMessage m = random_v2_message(rng, 3);
   const auto good = encode(m, kDatagramVersion2);
   JointsMessage sentinel;
   sentinel.sequence = 4242;
@@ -174,15 +174,15 @@ TEST(DatagramV2, CorruptionsAreRejectedAndTheOutputUntouched) {
   JointsMessage out;
   auto bad = good;
   bad[40 + 32] = 3;  // solved_by 3 does not exist
-  refresh_crc(bad);
+  refresh_v2_crc(bad);
   EXPECT_EQ(decode_datagram(bad.data(), bad.size(), out), DecodeStatus::kBadRecord);
   bad = good;
   bad[40 + 72 + 33] = 2;  // rate_valid of the second record
-  refresh_crc(bad);
+  refresh_v2_crc(bad);
   EXPECT_EQ(decode_datagram(bad.data(), bad.size(), out), DecodeStatus::kBadRecord);
   bad = good;
   bad[4] = 1;  // a v2 body announced as v1: the length does not fit
-  refresh_crc(bad);
+  refresh_v2_crc(bad);
   EXPECT_EQ(decode_datagram(bad.data(), bad.size(), out), DecodeStatus::kBadLength);
 }
 
