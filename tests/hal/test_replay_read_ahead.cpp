@@ -140,13 +140,13 @@ TEST(ReplayReadAhead, DestructionWhileWaitingOrWorkingJoins) {
 // statuses hold, and every buffer handed out is a distinct one while held.
 TEST(ReplayReadAhead, StressWithFewBuffersKeepsOrderAndContent) {
   mocap::test::TempDir tmp{"ahead"};
-  constexpr int kFrames = 120;
-  const auto rec = write_ahead_recording(tmp.path(), kFrames);
+  constexpr int kAheadFrames = 120;
+  const auto rec = write_ahead_recording(tmp.path(), kAheadFrames);
   std::mt19937 rng(4);
   for (int buffers : {1, 2, 3}) {
     auto ra = start_ahead(rec, buffers);
     std::deque<ReplayLoaded> holding;
-    for (std::int64_t f = 0; f < kFrames; ++f) {
+    for (std::int64_t f = 0; f < kAheadFrames; ++f) {
       ReplayLoaded got;
       ASSERT_TRUE(ra->wait_next(got, monotonic_ns() + 5'000'000'000)) << "frame " << f;
       for (const ReplayLoaded& h : holding) ASSERT_NE(h.buffer, got.buffer);
