@@ -69,7 +69,7 @@ TEST(JointRates, SmoothMotionsWithinFiveDegPerSecondAndStatedSdCoversTheError) {
   };
   for (const Case c : {Case{72, 0.75, 0.05}, Case{40, 0.5, 0.1}, Case{20, 0.25, 0.1},
                        Case{72, 0.75, 0.1}, Case{5, 0.3, 0.05}, Case{0, 0.5, 0.1}}) {
-    SCOPED_TRACE(testing::Message()
+    SCOPED_TRACE(::testing::Message()
                  << c.amplitude_deg << " deg at " << c.f_hz << " Hz, sd " << c.sd_deg);
     const Score s = sinusoid(c.amplitude_deg, c.f_hz, c.sd_deg, c.sd_deg);
     EXPECT_LT(s.rms_error_deg_s, 6.0);
@@ -80,7 +80,7 @@ TEST(JointRates, SmoothMotionsWithinFiveDegPerSecondAndStatedSdCoversTheError) {
 
 TEST(JointRates, StatedSdTooSmallOrTooLargeStillCovered) {
   for (const double ratio : {0.5, 2.0, 5.0}) {
-    SCOPED_TRACE(testing::Message() << "true sd = stated sd x " << ratio);
+    SCOPED_TRACE(::testing::Message() << "true sd = stated sd x " << ratio);
     const Score s = sinusoid(40, 0.5, 0.1 * ratio, 0.1);
     EXPECT_GT(s.rms_sd_deg_s, 0.5 * s.rms_error_deg_s);
     EXPECT_LT(s.rms_sd_deg_s, 2.0 * s.rms_error_deg_s);
