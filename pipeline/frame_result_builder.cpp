@@ -27,7 +27,7 @@ void make_joints_message(std::uint64_t sequence, std::int64_t capture_ns, const 
                   : 0u;
   const std::size_t n = std::min<std::size_t>(out.angles.joints.size(), client::kMaxJoints);
   msg.joint_count = static_cast<std::uint16_t>(n);
-  msg.reserved = 0;
+  msg.lead_us = 0;
   for (std::size_t j = 0; j < n; ++j) {
     const kinematics::JointAngle& a = out.angles.joints[j];
     client::JointRecord& r = msg.joints[j];
@@ -93,6 +93,15 @@ void make_frame_result(std::uint64_t sequence, std::int64_t capture_ns, const Ta
     rb.q_world_body = {q.w(), q.x(), q.y(), q.z()};
     const Vec3 t = pose.T_world_body.translation();
     rb.t_world_body_mm = {t.x(), t.y(), t.z()};
+    if (static_cast<std::size_t>(b) < out.body_rates.size()) {
+      const kinematics::BodyRate& r = out.body_rates[static_cast<std::size_t>(b)];
+      rb.velocity_valid = r.valid ? 1 : 0;
+      for (int k = 0; r.valid && k < 3; ++k) {
+        const auto uk = static_cast<std::size_t>(k);
+        rb.v_world_mm_s[uk] = static_cast<float>(r.v_world_mm_s[k]);
+        rb.w_world_rad_s[uk] = static_cast<float>(r.w_world_rad_s[k]);
+      }
+    }
   }
   // The labelled markers: the one list of the frame (track/labelled_markers.h).
   label_markers(out, targets, labelled);

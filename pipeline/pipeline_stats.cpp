@@ -68,7 +68,8 @@ PipelineStats Pipeline::stats() const {
   identify_->report(s.counters);
   publish_->report(s.counters);
   s.counters.emplace_back("frames_dropped", health().frames_dropped);
-  // Per output sink (the output seam): output_<name>_published/failures/dropped/no_listener.
+  // Per output sink (the output seam):
+  // output_<name>_published/failures/dropped/no_listener/not_predicted.
   for (const publish::OutputSink* sink : sinks_) {
     const publish::OutputCounters oc = sink->counters();
     const std::string prefix = std::string("output_") + sink->name() + "_";
@@ -76,6 +77,7 @@ PipelineStats Pipeline::stats() const {
     s.counters.emplace_back(prefix + "failures", oc.failures);
     s.counters.emplace_back(prefix + "dropped", oc.dropped);
     s.counters.emplace_back(prefix + "no_listener", oc.no_listener);
+    s.counters.emplace_back(prefix + "not_predicted", oc.not_predicted);
   }
   return s;
 }

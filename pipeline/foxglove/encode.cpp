@@ -83,7 +83,8 @@ std::vector<ChannelInfo> live_view_channels(const FoxgloveScene& scene) {
   std::vector<ChannelInfo> channels = {
       ChannelInfo{kChannelTf, "/tf", "foxglove.FrameTransforms", frame_transforms_schema()},
       ChannelInfo{kChannelMarkers, "/markers", "foxglove.SceneUpdate", scene_update_schema()},
-      ChannelInfo{kChannelJoints, "/joints", "mocap.JointAngles", joints_schema()}};
+      ChannelInfo{kChannelJoints, "/joints", "mocap.JointAngles", joints_schema()},
+      ChannelInfo{kChannelBodies, "/bodies", "mocap.BodyStates", bodies_schema()}};
   for (std::size_t c = 0; c < scene.cameras.size(); ++c) {
     channels.push_back(ChannelInfo{kChannelBlobsFirst + static_cast<std::uint32_t>(c),
                                    "/" + scene.cameras[c].name + "/blobs", "foxglove.RawImage",
@@ -166,6 +167,39 @@ std::string encode_scene_update(const FoxgloveScene& scene, const publish::Frame
   return dump(update);
 }
 
+std::string encode_body_states(const FoxgloveScene& scene, const publish::FrameResult& frame,
+                               std::int64_t stamp_ns) {
+  json list = json::array();
+  const int n = std::min(clamp_count(frame.body_count, publish::kMaxResultBodies),
+                         static_cast<int>(scene.bodies.size()));
+  for (int i = 0; i < n; ++i) {
+    const publish::ResultBody& b = frame.bodies[i];
+    json body = {{"name", scene.bodies[i].name}, {"found", b.found != 0}};
+    if (b.found != 0) {
+      const bool v = b.velocity_valid != 0;
+      body["markers"] = b.markers;
+      body["rms_mm"] = finite(static_cast<double>(b.rms_mm));
+      body["position"] = vec_m(body_translation_mm(b));
+      body["orientation"] = quat(body_rotation(b));
+      body["velocity_m_s"] =
+          v ? json::array({finite(static_cast<double>(b.v_world_mm_s[0]) * kMetresPerMm),
+                           finite(static_cast<double>(b.v_world_mm_s[1]) * kMetresPerMm),
+                           finite(static_cast<double>(b.v_world_mm_s[2]) * kMetresPerMm)})
+            : json(nullptr);
+      body["angular_velocity_rad_s"] =
+          v ? json::array({finite(static_cast<double>(b.w_world_rad_s[0])),
+                           finite(static_cast<double>(b.w_world_rad_s[1])),
+                           finite(static_cast<double>(b.w_world_rad_s[2]))})
+            : json(nullptr);
+    }
+    list.push_back(std::move(body));
+  }
+  return dump(json({{"timestamp", stamp(stamp_ns)},
+                    {"sequence", frame.joints.sequence},
+                    {"frame_id", scene.world_frame},
+                    {"bodies", std::move(list)}}));
+}
+
 std::string encode_joint_angles(const FoxgloveScene& scene, const publish::FrameResult& frame,
                                 std::int64_t stamp_ns) {
   static constexpr const char* kSolvedBy[] = {"none", "poses", "chain"};
@@ -177,11 +211,17 @@ std::string encode_joint_angles(const FoxgloveScene& scene, const publish::Frame
     const client::JointQuality& q = msg.quality[i];
     const bool hinge = r.type == static_cast<std::uint8_t>(client::JointKind::kHinge);
     const int dof = hinge ? 1 : 3;
+    const client::JointRates& rt = msg.rates[i];
     json angles = json::array();
     json sd = json::array();
+    json rates = rt.valid ? json::array() : json(nullptr);
+    json rates_sd = rt.valid ? json::array() : json(nullptr);
     for (int k = 0; k < dof; ++k) {
       angles.push_back(finite(static_cast<double>(r.a[k])));
       sd.push_back(finite(static_cast<double>(q.sd_rad[k])));
+      if (!rt.valid) continue;
+      rates.push_back(finite(static_cast<double>(rt.rate_rad_s[k])));
+      rates_sd.push_back(finite(static_cast<double>(rt.sd_rad_s[k])));
     }
     const std::string name = r.index < scene.joints.size() ? scene.joints[r.index].name
                                                            : "joint" + std::to_string(r.index);
@@ -190,7 +230,9 @@ std::string encode_joint_angles(const FoxgloveScene& scene, const publish::Frame
                     {"valid", r.valid != 0},
                     {"angles_rad", std::move(angles)},
                     {"solved_by", q.solved_by < 3 ? kSolvedBy[q.solved_by] : "none"},
-                    {"sd_rad", std::move(sd)}});
+                    {"sd_rad", std::move(sd)},
+                    {"rate_rad_s", std::move(rates)},
+                    {"rate_sd_rad_s", std::move(rates_sd)}});
   }
   return dump(json({{"timestamp", stamp(stamp_ns)},
                     {"sequence", msg.sequence},

@@ -28,6 +28,7 @@ namespace mocap::foxglove {
 inline constexpr std::uint32_t kChannelTf = 1;
 inline constexpr std::uint32_t kChannelMarkers = 2;
 inline constexpr std::uint32_t kChannelJoints = 3;
+inline constexpr std::uint32_t kChannelBodies = 4;
 inline constexpr std::uint32_t kChannelBlobsFirst = 16;  // + camera index
 
 // The advertised channels, ids as above (a blob channel per camera of the scene).
@@ -37,6 +38,10 @@ std::string encode_frame_transforms(const FoxgloveScene& scene, const publish::F
                                     std::int64_t stamp_ns);
 std::string encode_scene_update(const FoxgloveScene& scene, const publish::FrameResult& frame,
                                 std::int64_t stamp_ns);
+// /bodies (mocap.BodyStates): every body of the targets with its quality (markers used,
+// fit residual), pose and, when known, velocities; found or not.
+std::string encode_body_states(const FoxgloveScene& scene, const publish::FrameResult& frame,
+                               std::int64_t stamp_ns);
 std::string encode_joint_angles(const FoxgloveScene& scene, const publish::FrameResult& frame,
                                 std::int64_t stamp_ns);
 

@@ -26,7 +26,7 @@ namespace mocap::publish {
 namespace {
 
 constexpr int kFrameQueueDepth = 4;  // frames waiting for the encoder: the newest matter
-// The 3D channels (/tf, /markers, /joints) at most this often by default: a display's
+// The 3D channels (/tf, /markers, /joints, /bodies) at most this often by default: a display's
 // rate. Every frame at 100 fps tripled the loopback traffic and its kernel (softirq) work,
 // which runs above the real-time stages (docs/performance.md, 2026-12-02).
 constexpr int kDefaultMaxRateHz = 50;
@@ -103,6 +103,11 @@ class FoxgloveSink final : public QueuedSink {
       server_->broadcast(kChannelJoints, ts,
                          std::make_shared<const std::string>(
                              foxglove::encode_joint_angles(scene_, frame, stamp_ns)));
+    }
+    if (server_->has_subscribers(foxglove::kChannelBodies)) {
+      server_->broadcast(foxglove::kChannelBodies, ts,
+                         std::make_shared<const std::string>(
+                             foxglove::encode_body_states(scene_, frame, stamp_ns)));
     }
   }
 

@@ -22,6 +22,7 @@ json integer() { return {{"type", "integer"}}; }
 json string() { return {{"type", "string"}}; }
 json boolean() { return {{"type", "boolean"}}; }
 json array_of(json items) { return {{"type", "array"}, {"items", std::move(items)}}; }
+json nullable(json schema) { return {{"anyOf", {std::move(schema), {{"type", "null"}}}}}; }
 
 json time_schema() {
   return object_of({{"sec", {{"type", "integer"}, {"minimum", 0}}},
@@ -108,13 +109,37 @@ std::string joints_schema() {
                           {"valid", boolean()},
                           {"angles_rad", array_of(number())},
                           {"solved_by", {{"type", "string"}, {"enum", {"none", "poses", "chain"}}}},
-                          {"sd_rad", array_of(number())}},
+                          {"sd_rad", array_of(number())},
+                          {"rate_rad_s", nullable(array_of(number()))},
+                          {"rate_sd_rad_s", nullable(array_of(number()))}},
                          "mocap.JointAngle");
   return object_of({{"timestamp", time_schema()},
                     {"sequence", integer()},
                     {"all_bodies_found", boolean()},
                     {"joints", array_of(joint)}},
                    "mocap.JointAngles")
+      .dump();
+}
+
+std::string bodies_schema() {
+  const json vec3 = array_of(number());
+  json body = {{"type", "object"},
+               {"title", "mocap.BodyState"},
+               {"properties",
+                {{"name", string()},
+                 {"found", boolean()},
+                 {"markers", integer()},
+                 {"rms_mm", number()},
+                 {"position", vector3()},
+                 {"orientation", quaternion()},
+                 {"velocity_m_s", nullable(vec3)},
+                 {"angular_velocity_rad_s", nullable(vec3)}}},
+               {"required", {"name", "found"}}};
+  return object_of({{"timestamp", time_schema()},
+                    {"sequence", integer()},
+                    {"frame_id", string()},
+                    {"bodies", array_of(body)}},
+                   "mocap.BodyStates")
       .dump();
 }
 

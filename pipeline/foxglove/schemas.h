@@ -12,6 +12,7 @@ namespace mocap::foxglove {
 std::string frame_transforms_schema();  // foxglove.FrameTransforms
 std::string scene_update_schema();      // foxglove.SceneUpdate
 std::string joints_schema();            // mocap.JointAngles (this project's own)
+std::string bodies_schema();            // mocap.BodyStates (this project's own)
 std::string raw_image_schema();         // foxglove.RawImage
 
 }  // namespace mocap::foxglove

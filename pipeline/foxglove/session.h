@@ -28,10 +28,9 @@
 
 namespace mocap::foxglove {
 
-// The live view's channels: /tf, /markers, /joints and one /<camera>/blobs per rig camera
-// (encode.h; make_scene keeps at most kMaxCameras). Until 2027-01 this was 8, so a rig of
-// 6 or more cameras (the humanoid's default 8) could not start the live view.
-inline constexpr std::size_t kMaxChannels = 3 + static_cast<std::size_t>(kMaxCameras);
+// The live view's channels: /tf, /markers, /joints, /bodies and one /<camera>/blobs per rig
+// camera (encode.h; make_scene keeps at most kMaxCameras).
+inline constexpr std::size_t kMaxChannels = 4 + static_cast<std::size_t>(kMaxCameras);
 inline constexpr int kMaxPendingHandshakes = 16;  // connections still in their HTTP request
 
 class Session;

@@ -30,11 +30,13 @@ struct OutputContext {
 
 // Counters every sink reports (read from other threads: relaxed snapshots).
 struct OutputCounters {
-  std::uint64_t published = 0;    // frames handed over to the transport / encoder
-  std::uint64_t failures = 0;     // frames the transport refused
-  std::uint64_t dropped = 0;      // frames dropped by a bounded queue (drop-oldest)
-  std::uint64_t no_listener = 0;  // frames sent while a destination reported no listener
-                                  // (UDP: ICMP port unreachable); not failures
+  std::uint64_t published = 0;      // frames handed over to the transport / encoder
+  std::uint64_t failures = 0;       // frames the transport refused
+  std::uint64_t dropped = 0;        // frames dropped by a bounded queue (drop-oldest)
+  std::uint64_t no_listener = 0;    // frames sent while a destination reported no listener
+                                    // (UDP: ICMP port unreachable); not failures
+  std::uint64_t not_predicted = 0;  // lead_ms outputs: frames sent as measured, their capture
+                                    // too old to predict to publish + lead (lead.h)
 };
 
 class OutputSink {

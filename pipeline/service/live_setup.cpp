@@ -2,6 +2,7 @@
 #include "pipeline/service/live_setup.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <cstring>
 
 #include "config/tracking_assets.h"
@@ -19,6 +20,17 @@ using config::CameraBackend;
 static_assert(config::kStageCount == pipeline::kStageKinds,
               "config::kStageNames lists the stage kinds of pipeline/stage_table.h");
 
+namespace {
+
+// A lead as an option value: microsecond resolution, as the messages carry it.
+std::string format_lead_ms(double lead_ms) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3f", lead_ms);
+  return buf;
+}
+
+}  // namespace
+
 Expected<config::RunConfig> resolve_run_config(const std::string& path, const CliOverrides& cli,
                                                bool targets_required) {
   config::RunConfig cfg = config::default_run_config();
@@ -31,6 +43,7 @@ Expected<config::RunConfig> resolve_run_config(const std::string& path, const Cl
     if (auto r = config::check_host_port("--udp", "", *cli.udp); !r) return r.error();
     cfg.outputs.udp = {*cli.udp};
     cfg.outputs.udp_versions = {1};
+    cfg.outputs.udp_leads_ms = {0.0};
   }
   if (cli.rate_hz) {
     if (auto r = config::check_trigger_rate_hz("--rate", *cli.rate_hz); !r) return r.error();
@@ -66,11 +79,21 @@ std::vector<publish::OutputRequest> output_requests(const config::RunConfig& cfg
         (i ? "," : "") +
         std::to_string(i < cfg.outputs.udp_versions.size() ? cfg.outputs.udp_versions[i] : 1);
   if (!versions.empty()) udp.options.emplace_back("versions", versions);
+  // "0,5,..." (ms): one lead per destination, given only when one is set.
+  const auto& leads = cfg.outputs.udp_leads_ms;
+  if (std::any_of(leads.begin(), leads.end(), [](double l) { return l > 0.0; })) {
+    std::string text;
+    for (std::size_t i = 0; i < cfg.outputs.udp.size(); ++i)
+      text += (i ? "," : "") + format_lead_ms(i < leads.size() ? leads[i] : 0.0);
+    udp.options.emplace_back("leads_ms", text);
+  }
   if (!cli.multicast_if.empty()) udp.options.emplace_back("multicast_if", cli.multicast_if);
   if (cli.multicast_ttl)
     udp.options.emplace_back("multicast_ttl", std::to_string(*cli.multicast_ttl));
   v.push_back(std::move(udp));
   v.push_back({"iceoryx", {cfg.outputs.iceoryx ? "true" : "false"}, file + ".iceoryx", {}});
+  if (cfg.outputs.iceoryx_lead_ms > 0.0)
+    v.back().options.emplace_back("lead_ms", format_lead_ms(cfg.outputs.iceoryx_lead_ms));
   for (const config::OutputEntry& e : cfg.outputs.more)
     v.push_back({e.name, e.values, e.where, e.options});
   return v;

@@ -135,6 +135,8 @@ void print_json(const client::JointsMessage& m, std::uint64_t gap, double age_ms
       ",\"age_ms\":" + json_number(age_ms, true) + ",\"gap\":" + std::to_string(gap) +
       ",\"flags\":" + std::to_string(m.flags) +
       ",\"all_bodies_found\":" + ((m.flags & client::kFlagAllBodiesFound) ? "true" : "false") +
+      ",\"predicted_lead_us\":" +
+      ((m.flags & client::kFlagPredicted) ? std::to_string(m.lead_us) : std::string("null")) +
       ",\"joints\":[";
   for (std::size_t j = 0; j < m.joint_count && j < client::kMaxJoints; ++j) {
     const client::JointRecord& r = m.joints[j];
@@ -170,6 +172,8 @@ void print_message(const client::JointsMessage& m, std::uint64_t gap, const std:
   std::printf("seq %llu age %.3f ms gap %llu%s", static_cast<unsigned long long>(m.sequence),
               age_ms, static_cast<unsigned long long>(gap),
               (m.flags & client::kFlagAllBodiesFound) ? "" : " (bodies missing)");
+  if (m.flags & client::kFlagPredicted)
+    std::printf(" predicted to publish + %.3f ms", static_cast<double>(m.lead_us) * 1e-3);
   for (std::size_t j = 0; j < m.joint_count && j < client::kMaxJoints; ++j) {
     const client::JointRecord& r = m.joints[j];
     const bool hinge = r.type == static_cast<std::uint8_t>(client::JointKind::kHinge);

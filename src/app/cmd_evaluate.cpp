@@ -7,7 +7,8 @@
 //   distance    --poses OUT/poses.csv --segments gt/segments.csv          (Table 1A)
 //   precision   --targets T --model M --poses OUT/poses.csv --angles OUT/angles.csv (1B)
 //   angles      --truth REC/gt --angles OUT/angles.csv [--series errors.csv]
-//   rates       --truth REC/gt --angles OUT/angles.csv   (joint rates and their sd; last
+//   rates       --truth REC/gt --angles OUT/angles.csv [--poses OUT/poses.csv]
+//               (joint rates and their sd, and with --poses the body velocities; last
 //               row "all": every sample pooled)
 #include <cmath>
 #include <cstdio>
@@ -163,6 +164,26 @@ int run_rates(const EvaluateArgs& a) {
                 r.joint.c_str(), static_cast<long long>(r.samples), r.rms_deg_s, r.max_deg_s,
                 r.rms_sd_deg_s, r.sd_ratio);
   }
+  if (a.poses.empty()) return 0;
+  // Body velocities (poses.csv vx..sd_wz), when asked for.
+  auto poses = read_poses_csv(a.poses);
+  if (!poses) return fail(poses.error().message);
+  BodyRateError pooled;
+  std::vector<BodyRateError> bodies = body_rate_errors(truth->poses, *poses, &pooled);
+  if (pooled.linear_mm_s.samples == 0)
+    return fail(a.poses + ": no body velocities (columns vx..sd_wz) at frames of the ground truth");
+  bodies.push_back(pooled);
+  std::printf(
+      "\n| run | body | samples | RMS velocity error [mm/s] | max [mm/s] | RMS stated sd [mm/s] | "
+      "sd / RMS | RMS angular velocity error [deg/s] | max [deg/s] | RMS stated sd [deg/s] | "
+      "sd / RMS |\n| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n");
+  for (const BodyRateError& r : bodies) {
+    const RateStats& v = r.linear_mm_s;
+    const RateStats& w = r.angular_deg_s;
+    std::printf("| %s | %s | %lld | %.2f | %.2f | %.2f | %.2f | %.3f | %.3f | %.3f | %.2f |\n",
+                a.label.c_str(), r.body.c_str(), static_cast<long long>(v.samples), v.rms, v.max,
+                v.rms_sd, v.sd_ratio, w.rms, w.max, w.rms_sd, w.sd_ratio);
+  }
   return 0;
 }
 
@@ -205,6 +226,8 @@ void register_evaluate(CLI::App& app, int& exit_code) {
       "rates", "Joint-rate errors (angles.csv da0..da2) and their stated sd against ground truth");
   rates->add_option("--truth", args->truth, "Ground-truth folder (REC/gt)")->required();
   rates->add_option("--angles", args->angles, "Tracked angles.csv")->required();
+  rates->add_option("--poses", args->poses,
+                    "Tracked poses.csv: also the body velocities (vx..sd_wz) against the truth");
   common(rates);
   rates->callback([args, &exit_code] { exit_code = run_rates(*args); });
 }

@@ -119,7 +119,7 @@ std::size_t encode_datagram(const JointsMessage& msg, std::uint8_t* buf, std::si
   put_u64(buf + 16, static_cast<std::uint64_t>(msg.capture_ns));
   put_u64(buf + 24, static_cast<std::uint64_t>(msg.publish_ns));
   put_u32(buf + 32, msg.flags);
-  put_u32(buf + 36, 0);
+  put_u32(buf + 36, (msg.flags & kFlagPredicted) != 0 ? msg.lead_us : 0u);
   std::uint8_t* r = buf + kDatagramHeaderBytes;
   if (version == kDatagramVersion) {
     std::memcpy(r, msg.joints, kJointRecordBytes * msg.joint_count);
@@ -162,7 +162,11 @@ DecodeStatus decode_datagram(const std::uint8_t* buf, std::size_t len, JointsMes
   out.publish_ns = static_cast<std::int64_t>(get_u64(buf + 24));
   out.flags = get_u32(buf + 32);
   out.joint_count = joint_count;
-  out.reserved = 0;
+  // The lead of a predicted message (the reserved field of datagrams before 2027-01, 0).
+  const std::uint32_t lead_us = get_u32(buf + 36);
+  out.lead_us = (out.flags & kFlagPredicted) != 0 && lead_us <= 0xFFFFu
+                    ? static_cast<std::uint16_t>(lead_us)
+                    : std::uint16_t{0};
   r = buf + kDatagramHeaderBytes;
   for (std::size_t j = 0; j < joint_count; ++j, r += record_bytes) {
     std::memcpy(&out.joints[j], r, kJointRecordBytes);

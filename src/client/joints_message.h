@@ -26,6 +26,9 @@ struct JointRecord {
 };
 
 inline constexpr std::uint32_t kFlagAllBodiesFound = 1u << 0;
+// 2027-01: the angles (and their sds and quaternions) are predicted to publish_ns + lead_us
+// by the tracker (outputs.*.lead_ms), not measured at capture_ns.
+inline constexpr std::uint32_t kFlagPredicted = 1u << 1;
 
 // How a joint's angles were obtained in this frame (2026-12 extension).
 enum class SolvedBy : std::uint8_t {
@@ -68,9 +71,10 @@ struct JointsMessage {
   std::uint64_t sequence = 0;     // counts every triggered frame: a gap means drops
   std::int64_t capture_ns = 0;    // CLOCK_MONOTONIC, trigger of this frame
   std::int64_t publish_ns = 0;    // CLOCK_MONOTONIC, when published
-  std::uint32_t flags = 0;        // kFlagAllBodiesFound
+  std::uint32_t flags = 0;        // kFlagAllBodiesFound, kFlagPredicted
   std::uint16_t joint_count = 0;  // records used in `joints`
-  std::uint16_t reserved = 0;
+  std::uint16_t lead_us = 0;      // kFlagPredicted: the lead (us) the state is predicted by
+                                  // past publish_ns (<= 50000); else 0 (was `reserved`)
   JointRecord joints[kMaxJoints];
   // Appended by the 2026-12 extension (the layout above is unchanged): quality[j] belongs
   // to joints[j].

@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <numbers>
 
+#include "client/predict.h"
 #include "config/config_reader.h"
 #include "config/tracking_assets.h"
 #include "formats/rig_yaml.h"
@@ -26,6 +27,9 @@ using formats_detail::index_path;
 using formats_detail::line_suffix;
 
 namespace {
+
+// The longest lead an output may predict by: the client library's prediction horizon.
+constexpr double kMaxLeadMs = client::kDefaultPredictHorizonS * 1e3;
 
 namespace fs = std::filesystem;
 
@@ -218,15 +222,18 @@ void read_outputs(const std::string& file, const YAML::Node& node, OutputSetting
     if (!list.IsNull()) {
       formats_detail::require_list(list, s.path("udp"));
       o.udp_versions.clear();
+      o.udp_leads_ms.clear();
       for (std::size_t i = 0; i < list.size(); ++i) {
         const std::string where = index_path(s.path("udp"), i);
         std::uint16_t version = 1;
+        double lead_ms = 0.0;
         YAML::Node item;  // reset(), never operator= (see above)
         item.reset(list[i]);
-        if (list[i].IsMap()) {  // {value: HOST:PORT, version: 1 | 2}
-          const Section m(list[i], where, {"value", "version"});
+        if (list[i].IsMap()) {  // {value: HOST:PORT, version: 1 | 2, lead_ms: L}
+          const Section m(list[i], where, {"value", "version", "lead_ms"});
           if (!m.has("value")) fail(where, "the map form needs a 'value'" + line_suffix(list[i]));
           if (const auto v = m.integer("version", 1, 2)) version = static_cast<std::uint16_t>(*v);
+          if (const auto v = m.number("lead_ms", 0.0, kMaxLeadMs)) lead_ms = *v;
           item.reset(m.node("value"));
         }
         const std::string v = formats_detail::get_string(item, where);
@@ -234,10 +241,19 @@ void read_outputs(const std::string& file, const YAML::Node& node, OutputSetting
         if (!problem.empty()) fail(where, problem + line_suffix(item));
         o.udp.push_back(v);
         o.udp_versions.push_back(version);
+        o.udp_leads_ms.push_back(lead_ms);
       }
     }
   }
-  set(o.iceoryx, s.flag("iceoryx"));
+  if (s.has("iceoryx") && s.node("iceoryx").IsMap()) {  // {value: BOOL, lead_ms: L}
+    const Section m(s.node("iceoryx"), s.path("iceoryx"), {"value", "lead_ms"});
+    if (!m.has("value"))
+      fail(s.path("iceoryx"), "the map form needs a 'value'" + line_suffix(s.node("iceoryx")));
+    set(o.iceoryx, m.flag("value"));
+    if (const auto v = m.number("lead_ms", 0.0, kMaxLeadMs)) o.iceoryx_lead_ms = *v;
+  } else {
+    set(o.iceoryx, s.flag("iceoryx"));
+  }
 }
 
 void read_detection(const YAML::Node& node, detect::DetectorConfig& d) {
@@ -322,16 +338,20 @@ void read_identification(const YAML::Node& node, IdentifyConfig& c) {
   set(c.max_points, s.integer("max_points", 3, kMaxPoints));
 }
 
-// The joint-rate filter (kinematics/joint_rates.h), in the units of its keys.
+// The joint- and body-rate filters (kinematics/joint_rates.h, body_rates.h), in the units
+// of their keys.
 void read_velocity(const YAML::Node& node, kinematics::RateFilterConfig& c) {
   const Section s(node, "velocity",
-                  {"max_gap_ms", "warmup_frames", "jerk_psd_deg2_per_s5", "min_angle_sd_deg"});
+                  {"max_gap_ms", "warmup_frames", "jerk_psd_deg2_per_s5", "min_angle_sd_deg",
+                   "body_jerk_psd_mm2_per_s5", "min_position_sd_mm"});
   constexpr double kRad = std::numbers::pi / 180.0;
   if (const auto v = positive(s, "max_gap_ms", 60'000.0)) c.max_gap_s = *v * 1e-3;
   set(c.warmup_observations, s.integer("warmup_frames", 1, 100));
   if (const auto v = positive(s, "jerk_psd_deg2_per_s5", 1e12))
     c.jerk_psd_rad2_s5 = *v * kRad * kRad;
   if (const auto v = positive(s, "min_angle_sd_deg", 10.0)) c.min_angle_sd_rad = *v * kRad;
+  if (const auto v = positive(s, "body_jerk_psd_mm2_per_s5", 1e15)) c.body_jerk_psd_mm2_s5 = *v;
+  if (const auto v = positive(s, "min_position_sd_mm", 10.0)) c.min_position_sd_mm = *v;
 }
 
 Expected<RunConfig> parse(const std::string& path, const YAML::Node& root) {

@@ -88,7 +88,11 @@ struct OutputSettings {
   // The datagram version of each udp destination (1 or 2: the map form `{value: HOST:PORT,
   // version: 2}`); same length as udp.
   std::vector<std::uint16_t> udp_versions = {1};
+  // The lead of each udp destination (ms; 0: the measured state; the map form's `lead_ms`:
+  // the state predicted to publish + lead, pipeline/publish/lead.h); same length as udp.
+  std::vector<double> udp_leads_ms = {0.0};
   bool iceoryx = true;
+  double iceoryx_lead_ms = 0.0;   // `iceoryx: {value: true, lead_ms: L}`
   std::vector<OutputEntry> more;  // in file order
 };
 

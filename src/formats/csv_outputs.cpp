@@ -19,6 +19,10 @@ namespace {
 constexpr const char* kPointsHeader = "frame,x,y,z,reproj_px";
 constexpr const char* kPointsHeaderCameras = "frame,x,y,z,reproj_px,cameras";
 constexpr const char* kPosesHeader = "frame,timestamp_ns,body,qw,qx,qy,qz,tx,ty,tz,markers,rms_mm";
+// The header written: the spec's columns plus the 2027-01 extension columns (body velocities).
+constexpr const char* kPosesHeaderWritten =
+    "frame,timestamp_ns,body,qw,qx,qy,qz,tx,ty,tz,markers,rms_mm,"
+    "vx,vy,vz,wx,wy,wz,sd_vx,sd_vy,sd_vz,sd_wx,sd_wy,sd_wz";
 constexpr const char* kAnglesHeader = "frame,timestamp_ns,joint,type,a0,a1,a2,qw,qx,qy,qz";
 // The header written: the spec's columns plus the 2026-12 and 2027-01 extension columns.
 constexpr const char* kAnglesHeaderWritten =
@@ -64,7 +68,7 @@ Expected<CsvFile> open_points_csv(const std::string& path, bool with_cameras) {
   return CsvFile::open(path, with_cameras ? kPointsHeaderCameras : kPointsHeader);
 }
 Expected<CsvFile> open_poses_csv(const std::string& path) {
-  return CsvFile::open(path, kPosesHeader);
+  return CsvFile::open(path, kPosesHeaderWritten);
 }
 Expected<CsvFile> open_angles_csv(const std::string& path) {
   return CsvFile::open(path, kAnglesHeaderWritten);
@@ -83,10 +87,21 @@ void write_row(CsvFile& f, const PointRow& r) noexcept {
 void write_row(CsvFile& f, const PoseRow& r) noexcept {
   if (!f.handle()) return;
   const Quat q = qw_positive(r.q_world_body);
-  std::fprintf(f.handle(), "%lld,%lld,%s,%.9f,%.9f,%.9f,%.9f,%.6f,%.6f,%.6f,%d,%.6f\n",
+  std::fprintf(f.handle(), "%lld,%lld,%s,%.9f,%.9f,%.9f,%.9f,%.6f,%.6f,%.6f,%d,%.6f",
                static_cast<long long>(r.frame), static_cast<long long>(r.timestamp_ns),
                r.body.c_str(), q.w(), q.x(), q.y(), q.z(), r.t_world_body.x(), r.t_world_body.y(),
                r.t_world_body.z(), r.markers, r.rms_mm);
+  if (r.has_velocity) {
+    const Vec3& v = r.v_world_mm_s;
+    const Vec3& w = r.w_world_deg_s;
+    const Vec3& sv = r.v_sd_mm_s;
+    const Vec3& sw = r.w_sd_deg_s;
+    std::fprintf(f.handle(), ",%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f\n",
+                 v.x(), v.y(), v.z(), w.x(), w.y(), w.z(), sv.x(), sv.y(), sv.z(), sw.x(), sw.y(),
+                 sw.z());
+  } else {
+    std::fputs(",,,,,,,,,,,,\n", f.handle());
+  }
 }
 
 void write_row(CsvFile& f, const AngleRow& r) noexcept {
@@ -141,6 +156,13 @@ Expected<std::vector<PoseRow>> read_poses_csv(const std::string& path) {
       if (markers < 0 || markers > 1000000) fail(r.where(), "column 'markers': out of range");
       p.markers = static_cast<int>(markers);
       p.rms_mm = r.number(11);
+      if (r.has_column(23) && !r.field_empty(12)) {
+        p.has_velocity = true;
+        p.v_world_mm_s = Vec3(r.number(12), r.number(13), r.number(14));
+        p.w_world_deg_s = Vec3(r.number(15), r.number(16), r.number(17));
+        p.v_sd_mm_s = Vec3(r.number(18), r.number(19), r.number(20));
+        p.w_sd_deg_s = Vec3(r.number(21), r.number(22), r.number(23));
+      }
       rows.push_back(std::move(p));
     }
     return rows;

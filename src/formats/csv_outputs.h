@@ -32,6 +32,14 @@ struct PoseRow {
   Vec3 t_world_body = Vec3::Zero();
   int markers = 0;
   double rms_mm = 0.0;
+  // Extension columns (2027-01): the live tracker's causal velocity of the body origin
+  // vx,vy,vz (mm/s) and angular velocity wx,wy,wz (deg/s), both in the world frame, and
+  // their sds sd_vx..sd_wz, written empty while not known. Files without them read as none.
+  bool has_velocity = false;
+  Vec3 v_world_mm_s = Vec3::Zero();
+  Vec3 w_world_deg_s = Vec3::Zero();
+  Vec3 v_sd_mm_s = Vec3::Zero();
+  Vec3 w_sd_deg_s = Vec3::Zero();
 };
 
 struct AngleRow {

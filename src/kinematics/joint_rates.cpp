@@ -1,6 +1,5 @@
-// Design: see joint_rates.h. The filter of one degree of freedom is written out on the
-// six numbers of its symmetric covariance (no Eigen temporaries: it runs 42 times a frame
-// on the humanoid, inside the identify thread's budget).
+// Design: see joint_rates.h. One CaAxis (ca_filter.h) per degree of freedom, one CaClock
+// per joint.
 #include "kinematics/joint_rates.h"
 
 #include <algorithm>
@@ -14,15 +13,6 @@ namespace {
 constexpr double kPi = std::numbers::pi;
 constexpr double kInitialRateSdRadPerS = 20.0;     // ~1150 deg/s: unknown at a restart
 constexpr double kInitialAccelSdRadPerS2 = 500.0;  // unknown at a restart
-constexpr double kNisTimeConstantS = 0.3;          // running mean of the NIS
-constexpr double kLambdaGainPerS = 5.0;            // d ln(lambda)/dt per unit of NIS excess
-constexpr double kKappaTimeConstantS = 1.0;        // running mean of the noise ratio
-constexpr double kMaxNisSample = 25.0;             // one outlier moves the means this much
-constexpr double kMaxRatioSample = 100.0;
-constexpr double kLambdaMin = 1e-2, kLambdaMax = 1e3;
-constexpr double kKappaMin = 0.25, kKappaMax = 400.0;
-constexpr double kAdaptMaxStepS = 0.05;    // a long step adapts as this one at most
-constexpr double kSpacingTolerance = 0.1;  // third differences need equally spaced angles
 
 double wrap_pi(double a) noexcept {
   if (a > kPi || a <= -kPi) a -= 2.0 * kPi * std::floor((a + kPi) / (2.0 * kPi));
@@ -36,18 +26,27 @@ double angle_of(const JointAngle& a, int k) noexcept {
 
 }  // namespace
 
-Expected<JointRateFilter> JointRateFilter::create(const RateFilterConfig& config,
-                                                  const std::vector<JointType>& types) {
+Expected<void> check_rate_config(const RateFilterConfig& config) {
   const auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
   if (!positive(config.max_gap_s))
     return Error{"velocity.max_gap_ms: must be a positive number of milliseconds"};
   if (!positive(config.jerk_psd_rad2_s5))
     return Error{"velocity.jerk_psd_deg2_per_s5: must be positive"};
+  if (!positive(config.body_jerk_psd_mm2_s5))
+    return Error{"velocity.body_jerk_psd_mm2_per_s5: must be positive"};
   if (!positive(config.min_angle_sd_rad))
     return Error{"velocity.min_angle_sd_deg: must be positive"};
+  if (!positive(config.min_position_sd_mm))
+    return Error{"velocity.min_position_sd_mm: must be positive"};
   if (config.warmup_observations < 1 || config.warmup_observations > 100)
     return Error{"velocity.warmup_frames: must be 1..100, not " +
                  std::to_string(config.warmup_observations)};
+  return {};
+}
+
+Expected<JointRateFilter> JointRateFilter::create(const RateFilterConfig& config,
+                                                  const std::vector<JointType>& types) {
+  if (auto ok = check_rate_config(config); !ok) return ok.error();
   JointRateFilter f;
   f.config_ = config;
   f.joints_.resize(types.size());
@@ -74,114 +73,23 @@ double JointRateFilter::stated_variance(const JointAngle& a, int k) const noexce
 
 void JointRateFilter::restart(Joint& j, const JointAngle& a, std::int64_t t_ns) noexcept {
   ++counters_.restarts;
-  j.active = true;
-  j.observations = 1;
-  j.t_last_ns = t_ns;
-  j.hist = 1;
-  j.t_hist[0] = t_ns;
-  for (int k = 0; k < j.dofs; ++k) {
-    Dof& d = j.dof[static_cast<std::size_t>(k)];
-    const double v = stated_variance(a, k);
-    // The noise scales are kept: they describe the joint's measurement and motion, which
-    // a short loss of sight does not change.
-    const double z = angle_of(a, k);
-    d.x = {z, 0.0, 0.0};
-    d.P = {v * d.kappa, 0.0,
-           0.0,         kInitialRateSdRadPerS * kInitialRateSdRadPerS,
-           0.0,         kInitialAccelSdRadPerS2 * kInitialAccelSdRadPerS2};
-    d.z[0] = z;
-    d.v[0] = v;
-  }
+  j.clock.restart(t_ns);
+  for (int k = 0; k < j.dofs; ++k)
+    j.dof[static_cast<std::size_t>(k)].restart(angle_of(a, k), stated_variance(a, k),
+                                               kInitialRateSdRadPerS, kInitialAccelSdRadPerS2);
 }
 
 void JointRateFilter::step(Joint& j, JointAngle& a, std::int64_t t_ns) noexcept {
-  const double dt = static_cast<double>(t_ns - j.t_last_ns) * 1e-9;
-  const double h = 0.5 * dt * dt;
-  // Equally spaced history (for the third differences): shift it, or restart it.
-  bool equal_spacing = false;
-  if (j.hist == 4) {
-    for (int i = 0; i < 3; ++i) j.t_hist[static_cast<std::size_t>(i)] = j.t_hist[i + 1u];
-  }
-  const int slot = std::min(j.hist, 3);
-  j.t_hist[static_cast<std::size_t>(slot)] = t_ns;
-  const int n = slot + 1;
-  if (n == 4) {
-    const double s0 = static_cast<double>(j.t_hist[1] - j.t_hist[0]);
-    const double s1 = static_cast<double>(j.t_hist[2] - j.t_hist[1]);
-    const double s2 = static_cast<double>(j.t_hist[3] - j.t_hist[2]);
-    const double mean = (s0 + s1 + s2) / 3.0;
-    const double tol = kSpacingTolerance * mean;
-    equal_spacing =
-        std::abs(s0 - mean) <= tol && std::abs(s1 - mean) <= tol && std::abs(s2 - mean) <= tol;
-  }
-  const double adapt_dt = std::min(dt, kAdaptMaxStepS);
-  const double a_nis = std::min(1.0, adapt_dt / kNisTimeConstantS);
-  const double a_kappa = std::min(1.0, adapt_dt / kKappaTimeConstantS);
-
+  const CaStep s = j.clock.advance(t_ns);
   for (int k = 0; k < j.dofs; ++k) {
-    Dof& d = j.dof[static_cast<std::size_t>(k)];
-    // Predict: x = F x, P = F P F^T + q Q(dt).
-    auto& x = d.x;
-    auto& P = d.P;
-    x[0] += dt * x[1] + h * x[2];
-    x[1] += dt * x[2];
-    const double r00 = P[0] + dt * P[1] + h * P[2], r01 = P[1] + dt * P[3] + h * P[4],
-                 r02 = P[2] + dt * P[4] + h * P[5];
-    const double r11 = P[3] + dt * P[4], r12 = P[4] + dt * P[5];
-    const double q = config_.jerk_psd_rad2_s5 * d.lambda;
-    const double dt2 = dt * dt, dt3 = dt2 * dt;
-    P[0] = r00 + dt * r01 + h * r02 + q * dt3 * dt2 / 20.0;
-    P[1] = r01 + dt * r02 + q * dt2 * dt2 / 8.0;
-    P[2] = r02 + q * dt3 / 6.0;
-    P[3] = r11 + dt * r12 + q * dt3 / 3.0;
-    P[4] = r12 + q * dt2 / 2.0;
-    P[5] = P[5] + q * dt;
-
-    // Update with the angle, made continuous with the state.
-    const double v = stated_variance(a, k);
-    const double R = v * d.kappa;
-    const double y = wrap_pi(angle_of(a, k) - x[0]);
-    const double z = x[0] + y;
-    const double S = P[0] + R;
-    const double k0 = P[0] / S, k1 = P[1] / S, k2 = P[2] / S;
-    x[0] += k0 * y;
-    x[1] += k1 * y;
-    x[2] += k2 * y;
-    const double p00 = P[0], p01 = P[1], p02 = P[2];
-    P[0] = p00 - k0 * p00;
-    P[1] = p01 - k0 * p01;
-    P[2] = p02 - k0 * p02;
-    P[3] -= k1 * p01;
-    P[4] -= k1 * p02;
-    P[5] -= k2 * p02;
-
-    // Process-noise scale from the innovations.
-    d.nis_mean += a_nis * (std::min(y * y / S, kMaxNisSample) - d.nis_mean);
-    d.lambda = std::clamp(d.lambda * std::exp(kLambdaGainPerS * (d.nis_mean - 1.0) * adapt_dt),
-                          kLambdaMin, kLambdaMax);
-
-    // Measurement-noise scale from the third difference of equally spaced angles.
-    if (j.hist == 4) {
-      for (int i = 0; i < 3; ++i) {
-        d.z[static_cast<std::size_t>(i)] = d.z[i + 1u];
-        d.v[static_cast<std::size_t>(i)] = d.v[i + 1u];
-      }
-    }
-    d.z[static_cast<std::size_t>(slot)] = z;
-    d.v[static_cast<std::size_t>(slot)] = v;
-    if (equal_spacing) {
-      const double d3 = d.z[3] - 3.0 * d.z[2] + 3.0 * d.z[1] - d.z[0];
-      const double var3 = d.v[0] + 9.0 * d.v[1] + 9.0 * d.v[2] + d.v[3];
-      const double ratio = std::min(d3 * d3 / var3, kMaxRatioSample);
-      d.kappa = std::clamp(d.kappa + a_kappa * (ratio - d.kappa), kKappaMin, kKappaMax);
-    }
-
-    a.rate_rad_s[static_cast<std::size_t>(k)] = x[1];
-    a.rate_sd_rad_s[static_cast<std::size_t>(k)] = std::sqrt(std::max(P[3], 0.0));
+    const auto uk = static_cast<std::size_t>(k);
+    CaAxis& d = j.dof[uk];
+    // The innovation made continuous with the state (angles wrap, the state does not).
+    const double y = wrap_pi(angle_of(a, k) - d.predicted_value(s.dt_s));
+    d.step(s, config_.jerk_psd_rad2_s5, y, stated_variance(a, k));
+    a.rate_rad_s[uk] = d.x[1];
+    a.rate_sd_rad_s[uk] = d.rate_sd();
   }
-  j.hist = n;
-  j.t_last_ns = t_ns;
-  ++j.observations;
 }
 
 bool JointRateFilter::update(std::int64_t t_ns, JointAngles& angles) noexcept {
@@ -194,16 +102,16 @@ bool JointRateFilter::update(std::int64_t t_ns, JointAngles& angles) noexcept {
     a.rate_rad_s = {0.0, 0.0, 0.0};
     a.rate_sd_rad_s = {0.0, 0.0, 0.0};
     if (!a.valid) continue;
-    if (j.active && t_ns <= j.t_last_ns) {
+    if (j.clock.active && t_ns <= j.clock.t_last_ns) {
       ++counters_.time_reversals;
       continue;
     }
-    if (!j.active || t_ns - j.t_last_ns > max_gap_ns) {
+    if (!j.clock.active || t_ns - j.clock.t_last_ns > max_gap_ns) {
       restart(j, a, t_ns);
     } else {
       step(j, a, t_ns);
     }
-    if (j.observations < config_.warmup_observations) {
+    if (j.clock.observations < config_.warmup_observations) {
       a.rate_rad_s = {0.0, 0.0, 0.0};
       a.rate_sd_rad_s = {0.0, 0.0, 0.0};
       continue;

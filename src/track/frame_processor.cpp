@@ -78,6 +78,13 @@ Expected<FrameProcessor> FrameProcessor::create(const Rig& rig, const TargetSet&
     if (!rates) return rates.error();
     p.rates_.emplace(std::move(rates).value());
   }
+  // The point noise as chain tracking takes it (identification's, else the chain's own).
+  const double point_sigma_mm = config.identify.point_sigma_mm > 0.0
+                                    ? config.identify.point_sigma_mm
+                                    : config.chain.point_sigma_mm;
+  auto motion = BodyMotion::create(targets, point_sigma_mm, config.velocity);
+  if (!motion) return motion.error();
+  p.body_motion_.emplace(std::move(motion).value());
   p.warnings_ = p.identifier_.warnings();
   if (p.chain_) {
     for (const std::string& w : p.chain_->model().warnings())
@@ -122,6 +129,7 @@ FrameOutput FrameProcessor::make_output() const {
   out.points.set_capacity(pairs_.front().config().max_candidates);
   out.poses.count = identifier_.body_count();
   if (angles_) out.angles = angles_->make_output();
+  out.body_rates = body_motion_->make_output();
   return out;
 }
 
@@ -304,6 +312,7 @@ bool FrameProcessor::process_blobs(std::int64_t timestamp_ns, FrameOutput& out) 
     }
     if (rates_) rates_->update(timestamp_ns, out.angles);
   }
+  body_motion_->update(timestamp_ns, out.poses, out.body_rates);
   out.times.angles = monotonic_ns() - t;
   return identified;
 }
@@ -352,6 +361,7 @@ void FrameProcessor::reset() noexcept {
   selector_.reset();
   if (angles_) angles_->reset();
   if (rates_) rates_->reset();
+  body_motion_->reset();
 }
 
 }  // namespace mocap

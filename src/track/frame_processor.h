@@ -35,6 +35,7 @@
 #include "kinematics/joint_rates.h"
 #include "stereo/multiview.h"
 #include "stereo/stereo_triangulator.h"
+#include "track/body_motion.h"
 #include "track/chain_solver.h"
 #include "track/marker_shape.h"
 #include "track/point_selection.h"
@@ -68,7 +69,8 @@ struct TrackerConfig {
   // noise, confidence and angular speed bound are taken from `identify` at create() (one
   // source for each); the other keys are its own.
   ChainConfig chain{};
-  // The causal joint rates of every frame with a model (kinematics/joint_rates.h).
+  // The causal joint rates of every frame with a model (kinematics/joint_rates.h) and the
+  // body velocities of every frame (track/body_motion.h).
   kinematics::RateFilterConfig velocity{};
 };
 
@@ -88,6 +90,7 @@ struct FrameOutput {
   PointList points;
   BodyPoses poses;
   kinematics::JointAngles angles;
+  std::vector<kinematics::BodyRate> body_rates;  // one per target
   StageTimesNs times;
 };
 
@@ -109,7 +112,7 @@ class FrameProcessor {
   // Stages 2-4 on the blobs already in `out.blobs` (camera_present must be set).
   bool process_blobs(std::int64_t timestamp_ns, FrameOutput& out) noexcept;
 
-  // Forget temporal state (identification priors, hinge unwrapping, joint rates).
+  // Forget temporal state (identification priors, hinge unwrapping, joint and body rates).
   void reset() noexcept;
 
   // Whether 3D point i of the last processed frame was measured from a partial marker
@@ -134,6 +137,10 @@ class FrameProcessor {
   // Joint-rate filter counters; null without a model.
   const kinematics::RateFilterCounters* rate_counters() const noexcept {
     return rates_ ? &rates_->counters() : nullptr;
+  }
+  // Body-velocity filter counters.
+  const kinematics::RateFilterCounters& body_rate_counters() const noexcept {
+    return body_motion_->counters();
   }
   // Chain-tracking counters; null without a model.
   const ChainCounters* chain_counters() const noexcept {
@@ -170,6 +177,7 @@ class FrameProcessor {
   std::optional<kinematics::JointAngleSolver> angles_;
   std::optional<ChainSolver> chain_;
   std::optional<kinematics::JointRateFilter> rates_;
+  std::optional<BodyMotion> body_motion_;  // set by create()
   ChainResult chain_result_;
   std::vector<std::string> warnings_;
   // Workspace, sized at create().

@@ -121,6 +121,15 @@ Expected<OfflineTrackResult> track_recording(const OfflineTrackOptions& opt) {
       pose_row.t_world_body = body.T_world_body.translation();
       pose_row.markers = body.markers;
       pose_row.rms_mm = body.rms_mm;
+      const auto ub = static_cast<std::size_t>(b);
+      pose_row.has_velocity = ub < out.body_rates.size() && out.body_rates[ub].valid;
+      if (pose_row.has_velocity) {
+        const kinematics::BodyRate& r = out.body_rates[ub];
+        pose_row.v_world_mm_s = r.v_world_mm_s;
+        pose_row.w_world_deg_s = r.w_world_rad_s * kDegPerRad;
+        pose_row.v_sd_mm_s = r.v_sd_mm_s;
+        pose_row.w_sd_deg_s = r.w_sd_rad_s * kDegPerRad;
+      }
       write_row(*poses_csv, pose_row);
     }
     if (angles_csv) {

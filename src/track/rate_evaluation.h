@@ -5,6 +5,9 @@
 // to +-180 deg: its own error (jerk x dt^2 / 6) is ~0.1 deg/s for a robot's motions at
 // 100 fps, far below the filter's. Each degree of freedom of a joint counts as one sample
 // (a ball joint three per frame, a hinge one).
+// Body velocities (poses.csv vx..sd_wz) likewise against the central differences of the
+// true poses: the origin's displacement, and the rotation vector of R_after R_before^T
+// (world frame); each coordinate counts as one sample.
 #pragma once
 
 #include <cstdint>
@@ -24,6 +27,26 @@ struct JointRateError {
   double rms_sd_deg_s = 0.0;  // RMS of the stated sd over the same samples
   double sd_ratio = 0.0;      // rms_sd / rms: 1 for a consistent filter
 };
+
+// Unit-free error statistics of one rate.
+struct RateStats {
+  std::int64_t samples = 0;
+  double rms = 0.0;
+  double max = 0.0;
+  double rms_sd = 0.0;    // RMS of the stated sd over the same samples
+  double sd_ratio = 0.0;  // rms_sd / rms: 1 for a consistent filter
+};
+
+struct BodyRateError {
+  std::string body;
+  RateStats linear_mm_s;    // velocity of the body origin
+  RateStats angular_deg_s;  // angular velocity
+};
+
+// Bodies in order of first appearance in `truth`; `all` (optional): every sample pooled.
+std::vector<BodyRateError> body_rate_errors(const std::vector<PoseRow>& truth,
+                                            const std::vector<PoseRow>& measured,
+                                            BodyRateError* all = nullptr);
 
 // Joints in order of first appearance in `truth`; `all` (optional): every sample pooled.
 std::vector<JointRateError> rate_errors(const std::vector<AngleRow>& truth,

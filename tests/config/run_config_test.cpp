@@ -134,6 +134,30 @@ TEST(RunConfig, UdpMapFormChoosesTheDatagramVersionAndVelocityIsRead) {
   EXPECT_EQ(d->outputs.udp_versions, (std::vector<std::uint16_t>{1}));
 }
 
+TEST(RunConfig, LeadsOfUdpDestinationsAndIceoryxAndBodyVelocityKeys) {
+  TempDir dir("cfg_lead");
+  write_file(dir.file("m.yaml"),
+             "outputs: {udp: ['10.0.0.2:9000', {value: '127.0.0.1:7756', version: 2, "
+             "lead_ms: 5}],\n"
+             "          iceoryx: {value: true, lead_ms: 2.5}}\n"
+             "velocity: {body_jerk_psd_mm2_per_s5: 1e7, min_position_sd_mm: 0.02}\n");
+  auto cfg = load_run_config(dir.file("m.yaml"));
+  ASSERT_TRUE(cfg) << cfg.error().message;
+  EXPECT_EQ(cfg->outputs.udp_leads_ms, (std::vector<double>{0.0, 5.0}));
+  EXPECT_EQ(cfg->outputs.udp_versions, (std::vector<std::uint16_t>{1, 2}));
+  EXPECT_TRUE(cfg->outputs.iceoryx);
+  EXPECT_DOUBLE_EQ(cfg->outputs.iceoryx_lead_ms, 2.5);
+  EXPECT_DOUBLE_EQ(cfg->tracker.velocity.body_jerk_psd_mm2_s5, 1e7);
+  EXPECT_DOUBLE_EQ(cfg->tracker.velocity.min_position_sd_mm, 0.02);
+  // The plain forms: no lead.
+  write_file(dir.file("d.yaml"), "outputs: {udp: ['127.0.0.1:1'], iceoryx: false}\n");
+  auto d = load_run_config(dir.file("d.yaml"));
+  ASSERT_TRUE(d) << d.error().message;
+  EXPECT_EQ(d->outputs.udp_leads_ms, (std::vector<double>{0.0}));
+  EXPECT_FALSE(d->outputs.iceoryx);
+  EXPECT_EQ(d->outputs.iceoryx_lead_ms, 0.0);
+}
+
 TEST(RunConfig, EmptyUdpListDisablesUdp) {
   TempDir dir("cfg_noudp");
   write_file(dir.file("m.yaml"), "outputs: {udp: []}\n");

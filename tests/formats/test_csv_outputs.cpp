@@ -41,6 +41,13 @@ std::vector<PoseRow> sample_poses() {
     r.t_world_body = Vec3(1.0 / 7.0, 2000.25, -3.5 * i);
     r.markers = 3 + i;
     r.rms_mm = 0.05 * i;
+    r.has_velocity = i != 0;  // the extension columns empty in the first row
+    if (r.has_velocity) {
+      r.v_world_mm_s = Vec3(12.5, -1000.25, 0.0625 * i);
+      r.w_world_deg_s = Vec3(-90.5, 0.125, 360.0);
+      r.v_sd_mm_s = Vec3(0.5, 0.75, 1.0);
+      r.w_sd_deg_s = Vec3(0.25, 0.125, 2.0);
+    }
     rows.push_back(r);
   }
   return rows;
@@ -106,7 +113,8 @@ TEST_F(CsvOutputsTest, PosesRoundTripWithQwPositive) {
     ASSERT_TRUE(f->close().ok());
   }
   const std::string text = test::read_file(path);
-  EXPECT_THAT(text, StartsWith("frame,timestamp_ns,body,qw,qx,qy,qz,tx,ty,tz,markers,rms_mm\n0,"
+  EXPECT_THAT(text, StartsWith("frame,timestamp_ns,body,qw,qx,qy,qz,tx,ty,tz,markers,rms_mm,"
+                               "vx,vy,vz,wx,wy,wz,sd_vx,sd_vy,sd_vz,sd_wx,sd_wy,sd_wz\n0,"
                                "1000000000000,upper_arm,"));
   auto back = read_poses_csv(path);
   ASSERT_TRUE(back.ok()) << back.error().message;
@@ -121,6 +129,11 @@ TEST_F(CsvOutputsTest, PosesRoundTripWithQwPositive) {
     EXPECT_NEAR((b.t_world_body - rows[i].t_world_body).cwiseAbs().maxCoeff(), 0.0, 5e-7);
     EXPECT_EQ(b.markers, rows[i].markers);
     EXPECT_NEAR(b.rms_mm, rows[i].rms_mm, 5e-7);
+    EXPECT_EQ(b.has_velocity, rows[i].has_velocity);
+    EXPECT_EQ(b.v_world_mm_s, rows[i].v_world_mm_s);  // exact in 4 decimals
+    EXPECT_EQ(b.w_world_deg_s, rows[i].w_world_deg_s);
+    EXPECT_EQ(b.v_sd_mm_s, rows[i].v_sd_mm_s);
+    EXPECT_EQ(b.w_sd_deg_s, rows[i].w_sd_deg_s);
   }
   auto f = open_poses_csv(path);
   ASSERT_TRUE(f.ok());

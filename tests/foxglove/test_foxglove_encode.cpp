@@ -166,6 +166,53 @@ TEST(FoxgloveEncode, JointAnglesWithNamesQualityAndFiniteNumbers) {
   EXPECT_EQ(j["joints"][1]["angles_rad"][0].get<double>(), 0.0);
 }
 
+TEST(FoxgloveEncode, BodyStatesCarryQualityPoseAndVelocities) {
+  const TargetSet t = two_bodies();
+  const FoxgloveScene scene = make_scene(t, nullptr).value();
+  publish::FrameResult f = frame_with_pose();
+  f.joints.sequence = 9;
+  f.bodies[0].markers = 4;
+  f.bodies[0].rms_mm = 0.125f;
+  f.bodies[0].velocity_valid = 1;
+  f.bodies[0].v_world_mm_s = {{100.0f, -200.0f, 0.0f}};
+  f.bodies[0].w_world_rad_s = {{0.0f, 0.0f, 1.5f}};
+  const json j = json::parse(encode_body_states(scene, f, 0));
+  EXPECT_EQ(j["sequence"], 9);
+  EXPECT_EQ(j["frame_id"], "mocap");
+  ASSERT_EQ(j["bodies"].size(), 2u);  // every body, found or not
+  const json& b = j["bodies"][0];
+  EXPECT_EQ(b["name"], "upper_arm");
+  EXPECT_EQ(b["found"], true);
+  EXPECT_EQ(b["markers"], 4);
+  EXPECT_DOUBLE_EQ(b["rms_mm"].get<double>(), 0.125);
+  EXPECT_DOUBLE_EQ(b["position"]["y"].get<double>(), 2.0);
+  EXPECT_DOUBLE_EQ(b["velocity_m_s"][1].get<double>(), -0.2);
+  EXPECT_DOUBLE_EQ(b["angular_velocity_rad_s"][2].get<double>(), 1.5);
+  EXPECT_EQ(j["bodies"][1]["found"], false);
+  EXPECT_FALSE(j["bodies"][1].contains("markers"));
+  f.bodies[0].velocity_valid = 0;  // not known yet: null, never a stale value
+  EXPECT_TRUE(json::parse(encode_body_states(scene, f, 0))["bodies"][0]["velocity_m_s"].is_null());
+}
+
+TEST(FoxgloveEncode, JointRatesWhenKnown) {
+  const TargetSet t = two_bodies();
+  const JointModel m = elbow();
+  const FoxgloveScene scene = make_scene(t, &m).value();
+  publish::FrameResult f;
+  f.joints.joint_count = 1;
+  f.joints.joints[0] = client::JointRecord{0, 1, 1, {0.5f, 0.0f, 0.0f}, {1, 0, 0, 0}};
+  f.joints.rates[0].valid = 1;
+  f.joints.rates[0].rate_rad_s[0] = 2.0f;
+  f.joints.rates[0].sd_rad_s[0] = 0.25f;
+  json j = json::parse(encode_joint_angles(scene, f, 0));
+  ASSERT_EQ(j["joints"][0]["rate_rad_s"].size(), 1u);
+  EXPECT_DOUBLE_EQ(j["joints"][0]["rate_rad_s"][0].get<double>(), 2.0);
+  EXPECT_DOUBLE_EQ(j["joints"][0]["rate_sd_rad_s"][0].get<double>(), 0.25);
+  f.joints.rates[0].valid = 0;
+  j = json::parse(encode_joint_angles(scene, f, 0));
+  EXPECT_TRUE(j["joints"][0]["rate_rad_s"].is_null());
+}
+
 TEST(FoxgloveEncode, DamagedCountsAreClamped) {
   const TargetSet t = two_bodies();
   const FoxgloveScene scene = make_scene(t, nullptr).value();
@@ -182,6 +229,7 @@ TEST(FoxgloveEncode, DamagedCountsAreClamped) {
   EXPECT_EQ(s["entities"][1]["spheres"].size(), 0u);
   const json j = json::parse(encode_joint_angles(scene, f, 0));
   EXPECT_EQ(j["joints"].size(), static_cast<std::size_t>(client::kMaxJoints));
+  EXPECT_EQ(json::parse(encode_body_states(scene, f, 0))["bodies"].size(), t.bodies.size());
 }
 
 Rig two_cameras() {
@@ -199,13 +247,15 @@ Rig two_cameras() {
 TEST(FoxgloveEncode, ChannelsAdvertiseValidJsonSchemas) {
   const Rig rig = two_cameras();
   const auto channels = live_view_channels(make_scene(two_bodies(), nullptr, &rig).value());
-  ASSERT_EQ(channels.size(), 5u);
+  ASSERT_EQ(channels.size(), 6u);
   EXPECT_EQ(channels[0].topic, "/tf");
   EXPECT_EQ(channels[1].schema_name, "foxglove.SceneUpdate");
-  EXPECT_EQ(channels[3].topic, "/left/blobs");
-  EXPECT_EQ(channels[4].id, kChannelBlobsFirst + 1);
-  EXPECT_EQ(channels[4].schema_name, "foxglove.RawImage");
-  EXPECT_EQ(live_view_channels(make_scene(two_bodies(), nullptr).value()).size(), 3u);
+  EXPECT_EQ(channels[3].topic, "/bodies");
+  EXPECT_EQ(channels[3].id, kChannelBodies);
+  EXPECT_EQ(channels[4].topic, "/left/blobs");
+  EXPECT_EQ(channels[5].id, kChannelBlobsFirst + 1);
+  EXPECT_EQ(channels[5].schema_name, "foxglove.RawImage");
+  EXPECT_EQ(live_view_channels(make_scene(two_bodies(), nullptr).value()).size(), 4u);
   for (const auto& c : channels) {
     const json s = json::parse(c.schema);
     EXPECT_EQ(s["type"], "object") << c.topic;
@@ -225,9 +275,9 @@ TEST(FoxgloveEncode, EveryCameraOfAnEightCameraRigHasItsBlobChannel) {
   }
   const FoxgloveScene scene = make_scene(two_bodies(), nullptr, &rig).value();
   const auto channels = live_view_channels(scene);
-  ASSERT_EQ(channels.size(), 3u + static_cast<std::size_t>(kMaxCameras));
+  ASSERT_EQ(channels.size(), 4u + static_cast<std::size_t>(kMaxCameras));
   for (int k = 0; k < kMaxCameras; ++k) {
-    const ChannelInfo& ch = channels[3 + static_cast<std::size_t>(k)];
+    const ChannelInfo& ch = channels[4 + static_cast<std::size_t>(k)];
     EXPECT_EQ(ch.topic, "/cam" + std::to_string(k) + "/blobs");
     EXPECT_EQ(ch.id, kChannelBlobsFirst + static_cast<std::uint32_t>(k));
   }

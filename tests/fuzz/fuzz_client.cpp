@@ -29,7 +29,7 @@ int fuzz_datagram(const std::uint8_t* data, std::size_t size) {
   out.publish_ns = -2;
   out.flags = 0xA5A5A5A5u;
   out.joint_count = 0xA5A5;
-  out.reserved = 0xA5A5;
+  out.lead_us = 0xA5A5;
   for (JointRecord& j : out.joints) j.index = 0xA5A5;
   const JointsMessage untouched = out;
   std::uint16_t version = 0;
@@ -38,7 +38,7 @@ int fuzz_datagram(const std::uint8_t* data, std::size_t size) {
   if (st != DecodeStatus::kOk) {
     fuzz_check(out.sequence == untouched.sequence && out.capture_ns == untouched.capture_ns &&
                    out.publish_ns == untouched.publish_ns && out.flags == untouched.flags &&
-                   out.joint_count == untouched.joint_count && out.reserved == untouched.reserved &&
+                   out.joint_count == untouched.joint_count && out.lead_us == untouched.lead_us &&
                    std::memcmp(out.joints, untouched.joints, sizeof out.joints) == 0,
                "rejected datagram modified the output");
     return 0;

@@ -131,7 +131,7 @@ TEST(OutputRegistry, BadRequestsFailWithOneLine) {
   ASSERT_FALSE(e.ok());
   EXPECT_EQ(e.error().message,
             "run.yaml: outputs.udp: multicast_tll: unknown option (known: "
-            "multicast_if multicast_ttl versions)");
+            "multicast_if multicast_ttl versions leads_ms)");
   e = check({"ros2", {"true"}, "run.yaml: outputs.ros2", {{"domain_id", "x"}}});
   ASSERT_FALSE(e.ok());
   EXPECT_EQ(e.error().message,

@@ -12,6 +12,7 @@
 #include "formats/targets_yaml.h"
 #include "tests/track/track_fixture.h"
 #include "track/offline_tracker.h"
+#include "track/rate_evaluation.h"
 
 namespace mocap {
 namespace {
@@ -88,12 +89,26 @@ TEST(OfflineTracker, WritesTheSpecFilesAndStats) {
   const std::string points = test::read_file(out.file("points.csv"));
   const std::string poses = test::read_file(out.file("poses.csv"));
   EXPECT_EQ(points.rfind("frame,x,y,z,reproj_px\n", 0), 0u);
-  EXPECT_EQ(poses.rfind("frame,timestamp_ns,body,qw,qx,qy,qz,tx,ty,tz,markers,rms_mm\n", 0), 0u);
+  // The spec's columns, then the body velocities (2027-01 extension columns at the end).
+  EXPECT_EQ(poses.rfind("frame,timestamp_ns,body,qw,qx,qy,qz,tx,ty,tz,markers,rms_mm,vx,", 0), 0u);
   EXPECT_FALSE(std::filesystem::exists(out.file("angles.csv")));  // no model given
   auto rows = read_poses_csv(out.file("poses.csv"));
   ASSERT_TRUE(rows.ok());
   EXPECT_GE(rows->size(), 12u * 2u);
   for (const PoseRow& p : *rows) EXPECT_GE(p.q_world_body.w(), 0.0);
+  // Body velocities from the third frame a body is seen on, consistent with the truth's
+  // central differences (the stated sd of the same order as the error).
+  int with_velocity = 0;
+  for (const PoseRow& p : *rows) with_velocity += p.has_velocity ? 1 : 0;
+  EXPECT_GE(with_velocity, 8 * 2);
+  auto truth = read_poses_csv(rec + "/gt/poses.csv");
+  ASSERT_TRUE(truth.ok()) << truth.error().message;
+  BodyRateError all;
+  body_rate_errors(*truth, *rows, &all);
+  ASSERT_GT(all.linear_mm_s.samples, 0);
+  EXPECT_LT(all.linear_mm_s.rms, 4.0 * all.linear_mm_s.rms_sd);
+  EXPECT_GT(all.linear_mm_s.rms, 0.1 * all.linear_mm_s.rms_sd);
+  EXPECT_LT(all.angular_deg_s.rms, 4.0 * all.angular_deg_s.rms_sd);
   const std::string stats = test::read_file(out.file("stats.json"));
   for (const char* key : {"\"frames\": 12", "\"detect\"", "\"triangulate\"", "\"identify\"",
                           "\"angles\"", "\"frame\"", "\"p50_us\"", "\"p99_us\"", "\"max_us\""}) {

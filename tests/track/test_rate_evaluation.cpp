@@ -1,6 +1,7 @@
 // Tests of the joint-rate evaluation (track/rate_evaluation.h): known rate errors and sds
 // against a true ramp (also across +-180 deg), rows without rates or without both true
-// neighbours left out, every sample pooled.
+// neighbours left out, every sample pooled; body velocities against a body moving and
+// turning at known rates (also through +-180 deg of rotation).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -68,6 +69,45 @@ TEST(RateErrors, NoRatesNoSamples) {
   ASSERT_EQ(e.size(), 1u);
   EXPECT_EQ(e[0].samples, 0);
   EXPECT_EQ(all.samples, 0);
+}
+
+PoseRow pose(std::int64_t frame, const std::string& body, double t_s) {
+  PoseRow p;
+  p.frame = frame;
+  p.timestamp_ns = frame * 10'000'000;
+  p.body = body;
+  // 500 mm/s along x, 90 deg/s about z (through 180 deg at 2 s).
+  p.t_world_body = Vec3(500.0 * t_s, 0.0, 100.0);
+  p.q_world_body = Quat(Eigen::AngleAxisd(t_s * 3.14159265358979 / 2.0, Vec3::UnitZ()));
+  return p;
+}
+
+TEST(BodyRateErrors, KnownErrorsAndStatedSdThroughAHalfTurn) {
+  std::vector<PoseRow> truth, measured;
+  for (int f = 0; f < 300; ++f) {
+    truth.push_back(pose(f, "hand", 0.01 * f));
+    PoseRow m = pose(f, "hand", 0.01 * f);
+    m.has_velocity = f % 3 != 0;
+    m.v_world_mm_s = Vec3(500.0 + 10.0, 0.0, 0.0);  // 10 mm/s error on x only
+    m.v_sd_mm_s = Vec3(10.0, 10.0, 10.0);
+    m.w_world_deg_s = Vec3(0.0, 0.0, 90.0 - 3.0);  // 3 deg/s error on z only
+    m.w_sd_deg_s = Vec3(1.0, 1.0, 1.0);
+    measured.push_back(m);
+  }
+  BodyRateError all;
+  const auto e = body_rate_errors(truth, measured, &all);
+  ASSERT_EQ(e.size(), 1u);
+  EXPECT_EQ(e[0].body, "hand");
+  EXPECT_EQ(e[0].linear_mm_s.samples, 3 * 199);  // frames 1..298 but the multiples of 3
+  EXPECT_NEAR(e[0].linear_mm_s.rms, 10.0 / std::sqrt(3.0), 1e-6);
+  EXPECT_NEAR(e[0].linear_mm_s.max, 10.0, 1e-6);
+  EXPECT_NEAR(e[0].angular_deg_s.rms, 3.0 / std::sqrt(3.0), 1e-6);
+  EXPECT_NEAR(e[0].angular_deg_s.max, 3.0, 1e-6);
+  EXPECT_NEAR(e[0].angular_deg_s.sd_ratio, 1.0 / std::sqrt(3.0), 1e-6);  // sd 1, RMS sqrt(3)
+  EXPECT_EQ(all.body, "all");
+  EXPECT_EQ(all.linear_mm_s.samples, e[0].linear_mm_s.samples);
+  // Files without the columns: no samples.
+  EXPECT_EQ(body_rate_errors(truth, truth)[0].linear_mm_s.samples, 0);
 }
 
 }  // namespace

@@ -7,8 +7,9 @@
     8      8    sequence number (uint64)
     16     8    capture timestamp, ns, CLOCK_MONOTONIC (trigger of the frame)
     24     8    publish timestamp, ns, same clock
-    32     4    flags (bit 0: every body of the model was found)
-    36     4    reserved, 0
+    32     4    flags (bit 0: every body of the model was found; bit 1: the state is
+                predicted by the tracker to publish + lead_us)
+    36     4    lead_us: with flag bit 1 the lead in microseconds, else 0
     40     32*J joint records: uint16 index, uint8 type (0 ball, 1 hinge), uint8 valid,
                 float32 a0 a1 a2 (radians), float32 qw qx qy qz
     40+32J 4    CRC-32 (zlib.crc32) of all bytes before it
@@ -30,6 +31,7 @@ VERSION_2 = 2
 BALL = 0
 HINGE = 1
 FLAG_ALL_BODIES_FOUND = 1
+FLAG_PREDICTED = 2
 MAX_JOINTS = 32
 
 _HEADER = struct.Struct("<4sHHQqqII")
@@ -45,9 +47,10 @@ JointRecord.__doc__ = ("One joint: index in model.yaml, type (BALL/HINGE), valid
                        "version 2 only (else None/False): solved_by (0 none, 1 poses, 2 chain), "
                        "sd of a (radians), rate_valid, rate = (da0, da1, da2) rad/s, rate_sd")
 
-Message = namedtuple("Message", "sequence capture_ns publish_ns flags joints version",
-                     defaults=(VERSION,))
-Message.__doc__ = "One decoded datagram; joints is a tuple of JointRecord."
+Message = namedtuple("Message", "sequence capture_ns publish_ns flags joints version lead_us",
+                     defaults=(VERSION, 0))
+Message.__doc__ = ("One decoded datagram; joints is a tuple of JointRecord; lead_us: with "
+                   "flags & FLAG_PREDICTED, the state is predicted to publish_ns + lead_us us.")
 
 
 class DecodeError(ValueError):
@@ -63,7 +66,7 @@ def decode(data):
     data = bytes(data)
     if len(data) < _HEADER.size + _CRC.size:
         raise DecodeError("short", "%d bytes, at least 44 needed" % len(data))
-    magic, version, count, seq, capture, publish, flags, _reserved = _HEADER.unpack_from(data, 0)
+    magic, version, count, seq, capture, publish, flags, lead_us = _HEADER.unpack_from(data, 0)
     if magic != b"MCAP":
         raise DecodeError("magic", "magic %r is not b'MCAP'" % magic)
     if version not in _RECORD_BYTES:
@@ -85,7 +88,8 @@ def decode(data):
             record = record._replace(solved_by=t[0], sd=tuple(t[2:5]), rate_valid=bool(t[1]),
                                      rate=tuple(t[5:8]), rate_sd=tuple(t[8:11]))
         joints.append(record)
-    return Message(seq, capture, publish, flags, tuple(joints), version)
+    lead_us = lead_us if flags & FLAG_PREDICTED and lead_us <= 0xFFFF else 0
+    return Message(seq, capture, publish, flags, tuple(joints), version, lead_us)
 
 
 def encode(message):
@@ -94,7 +98,8 @@ def encode(message):
     if version not in _RECORD_BYTES:
         raise ValueError("version %r is not 1 or 2" % (version,))
     out = bytearray(_HEADER.pack(b"MCAP", version, len(message.joints), message.sequence,
-                                 message.capture_ns, message.publish_ns, message.flags, 0))
+                                 message.capture_ns, message.publish_ns, message.flags,
+                                 message.lead_us if message.flags & FLAG_PREDICTED else 0))
     for j in message.joints:
         out += _RECORD.pack(j.index, j.type, 1 if j.valid else 0, *j.a, *j.q)
         if version == VERSION_2:
