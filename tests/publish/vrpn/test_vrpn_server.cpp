@@ -139,10 +139,14 @@ TEST(VrpnServer, UdpConnectionRequestConnectsBackThenUdpReportsOnRequest) {
   EXPECT_TRUE(c.reports[3].via_udp);
   EXPECT_EQ(c.reports[5].body, "hand");
   EXPECT_EQ(c.protocol_errors, 0);
+  // VRPN repeats its request every 2 s until connected: no second connection for it.
+  const std::string again = "127.0.0.1 " + std::to_string(c.listen_port());
+  c.send_datagram(fx.server->port(), again.c_str(), again.size() + 1);
   c.send_datagram(fx.server->port(), "bad host! 1", 12);
   fx.poll();
   c.pump(20);
   EXPECT_EQ(fx.server->counters().bad_requests, 1u);
+  EXPECT_EQ(fx.server->counters().connect_backs, 1u);
 }
 
 TEST(VrpnServer, PingFromANamedSenderGetsAPong) {

@@ -73,7 +73,8 @@ class Client {
         ::listen(listen_, 1) != 0)
       return false;
     ::getsockname(listen_, reinterpret_cast<sockaddr*>(&a), &len);
-    const std::string msg = "127.0.0.1 " + std::to_string(ntohs(a.sin_port));
+    listen_port_ = ntohs(a.sin_port);
+    const std::string msg = "127.0.0.1 " + std::to_string(listen_port_);
     send_datagram(server_port, msg.c_str(), msg.size() + 1);
     pollfd p{listen_, POLLIN, 0};
     const auto t0 = std::chrono::steady_clock::now();
@@ -167,6 +168,7 @@ class Client {
   std::vector<std::pair<std::string, std::string>> others;  // (sender, type) of the rest
   int protocol_errors = 0;
   int fd() const { return tcp_; }
+  std::uint16_t listen_port() const { return listen_port_; }  // of request_connect_back
 
  private:
   static sockaddr_in loopback(std::uint16_t port) {
@@ -243,6 +245,7 @@ class Client {
   }
 
   int tcp_ = -1, listen_ = -1, udp_in_ = -1;
+  std::uint16_t listen_port_ = 0;
   std::vector<std::uint8_t> in_;
 };
 
