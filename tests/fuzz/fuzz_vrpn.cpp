@@ -49,7 +49,7 @@ int fuzz_vrpn(const std::uint8_t* data, std::size_t size) {
                "message view outside the bytes");
     std::string_view name;
     if (parse_name_payload(v.payload, v.payload_len, name))
-      fuzz_check(name.size() < kMaxNameBytes && name.find('\0') == std::string_view::npos,
+      fuzz_check(name.size() <= kMaxNameChars && name.find('\0') == std::string_view::npos,
                  "name description");
     at += v.total_bytes;
   }

@@ -275,8 +275,10 @@ Expected<std::unique_ptr<Server>> Server::create(const ServerOptions& options,
     return make_error("vrpn", "",
                       "client buffer too small for " + std::to_string(bodies.size()) + " bodies");
   for (const std::string& b : bodies)
-    if (b.empty() || b.size() >= kMaxNameBytes)
-      return make_error("vrpn", "'" + b + "'", "a VRPN sender name has 1..99 characters");
+    if (b.empty() || b.size() > kMaxNameChars)
+      return make_error(
+          "vrpn", "'" + b + "'",
+          "a VRPN sender name has 1.." + std::to_string(kMaxNameChars) + " characters");
   auto sockets = open_listen_sockets(options);
   if (!sockets) return sockets.error();
   auto impl = std::make_unique<Impl>();

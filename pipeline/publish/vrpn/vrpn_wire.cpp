@@ -91,7 +91,7 @@ std::size_t write_message(std::uint8_t* out, std::size_t cap, std::int32_t type,
 
 std::size_t write_name_payload(std::uint8_t* out, std::size_t cap, std::string_view name) noexcept {
   const std::size_t with_nul = name.size() + 1;
-  if (name.empty() || with_nul > kMaxNameBytes || 4 + with_nul > cap) return 0;
+  if (name.empty() || name.size() > kMaxNameChars || 4 + with_nul > cap) return 0;
   put_u32(out, static_cast<std::uint32_t>(with_nul));
   std::memcpy(out + 4, name.data(), name.size());
   out[4 + name.size()] = 0;
@@ -137,9 +137,9 @@ ParseStatus parse_message(const std::uint8_t* in, std::size_t n, std::size_t max
 
 bool parse_name_payload(const std::uint8_t* payload, std::size_t n,
                         std::string_view& name) noexcept {
-  if (n < 5) return false;
+  if (n < 5 || n > kMaxNameBytes) return false;
   const std::uint32_t with_nul = get_u32(payload);
-  if (with_nul < 1 || with_nul > kMaxNameBytes || with_nul > n - 4) return false;
+  if (with_nul < 1 || with_nul > n - 4) return false;
   const char* text = reinterpret_cast<const char*>(payload + 4);
   if (text[with_nul - 1] != '\0') return false;
   if (std::memchr(text, '\0', with_nul - 1) != nullptr) return false;

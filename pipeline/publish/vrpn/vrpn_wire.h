@@ -30,10 +30,13 @@
 
 namespace mocap::publish::vrpn {
 
-inline constexpr std::size_t kAlign = 8;               // vrpn_ALIGN
-inline constexpr std::size_t kCookieBytes = 24;        // vrpn_cookie_size(): 16 + kAlign
-inline constexpr std::size_t kHeaderBytes = 24;        // 5 x int32 (+ sequence) padded to 8
-inline constexpr std::size_t kMaxNameBytes = 100;      // vrpn_CNAME, NUL included
+inline constexpr std::size_t kAlign = 8;           // vrpn_ALIGN
+inline constexpr std::size_t kCookieBytes = 24;    // vrpn_cookie_size(): 16 + kAlign
+inline constexpr std::size_t kHeaderBytes = 24;    // 5 x int32 (+ sequence) padded to 8
+inline constexpr std::size_t kMaxNameBytes = 100;  // vrpn_CNAME: a description's whole payload
+// The longest sender/type name: VRPN refuses a description payload (length word + name +
+// NUL) longer than vrpn_CNAME (handle_sender_message), so 100 - 4 - 1 characters.
+inline constexpr std::size_t kMaxNameChars = kMaxNameBytes - 5;
 inline constexpr std::size_t kUdpPayloadBytes = 1472;  // vrpn_CONNECTION_UDP_BUFLEN
 inline constexpr std::size_t kPosQuatPayloadBytes = 64;
 inline constexpr std::size_t kVelocityPayloadBytes = 72;
@@ -89,7 +92,7 @@ std::size_t write_message(std::uint8_t* out, std::size_t cap, std::int32_t type,
                           std::int32_t sender, WireTime time, std::uint32_t sequence,
                           const std::uint8_t* payload, std::size_t payload_len) noexcept;
 
-// Sender/type description payload of `name` (1..kMaxNameBytes-1 chars): bytes written
+// Sender/type description payload of `name` (1..kMaxNameChars chars): bytes written
 // to out[0, cap), 0 when it does not fit or the name is empty/too long.
 std::size_t write_name_payload(std::uint8_t* out, std::size_t cap, std::string_view name) noexcept;
 
@@ -111,7 +114,8 @@ ParseStatus parse_message(const std::uint8_t* in, std::size_t n, std::size_t max
                           MessageView& out) noexcept;
 
 // A sender/type description payload: the name (without NUL) when well formed: length
-// word 1..kMaxNameBytes, the name within the payload, NUL-terminated, no NUL inside.
+// payload at most kMaxNameBytes, length word >= 1, the name within the payload,
+// NUL-terminated, no NUL inside.
 bool parse_name_payload(const std::uint8_t* payload, std::size_t n,
                         std::string_view& name) noexcept;
 

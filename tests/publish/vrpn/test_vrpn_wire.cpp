@@ -48,6 +48,10 @@ TEST(VrpnWire, MessageHeaderPaddingAndPosQuatAreBigEndian) {
   ASSERT_EQ(n, 8u);  // length word (4, NUL included) + "arm\0"
   EXPECT_EQ(std::vector<std::uint8_t>(name, name + 8),
             (std::vector<std::uint8_t>{0, 0, 0, 4, 'a', 'r', 'm', 0}));
+  // VRPN refuses a description payload over vrpn_CNAME (100 bytes): names of <= 95 chars.
+  std::uint8_t longest[128];
+  EXPECT_EQ(write_name_payload(longest, sizeof longest, std::string(95, 'a')), 100u);
+  EXPECT_EQ(write_name_payload(longest, sizeof longest, std::string(96, 'a')), 0u);
   std::uint8_t msg[64];
   std::memset(msg, 0xAB, sizeof msg);
   const std::size_t m =
