@@ -1,6 +1,6 @@
 // Design: the VRPN server as an output of the seam (pipeline/publish; docs/vrpn.md): a
 // QueuedSink, so the real-time publish thread only copies the frame result into a
-// bounded drop-oldest queue (kFrameQueueDepth frames); this sink's worker thread is the
+// bounded drop-oldest queue (kVrpnFrameQueueDepth frames); this sink's worker thread is the
 // server's one thread: per frame it services the sockets (vrpn::Server::poll: accepts,
 // connection requests, client messages, flushes, deadlines) and sends the frame's
 // reports to every client; with no frame it services them from idle() (about every
@@ -23,7 +23,7 @@ namespace mocap::publish {
 
 namespace {
 
-constexpr int kFrameQueueDepth = 4;  // frames waiting for the server thread
+constexpr int kVrpnFrameQueueDepth = 4;  // frames waiting for the server thread
 
 std::int64_t vrpn_monotonic_ns() noexcept {
   timespec ts{};
@@ -34,7 +34,7 @@ std::int64_t vrpn_monotonic_ns() noexcept {
 class VrpnSink final : public QueuedSink {
  public:
   VrpnSink(std::unique_ptr<vrpn::Server> server, std::string notice)
-      : QueuedSink(kFrameQueueDepth),
+      : QueuedSink(kVrpnFrameQueueDepth),
         server_(std::move(server)),
         notice_(std::move(notice)),
         realtime_offset_ns_(realtime_offset_ns()) {}
