@@ -118,6 +118,11 @@ struct Server::Impl {
     c.window_bytes = 0;
     const int one = 1;
     ::setsockopt(c.fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);  // best effort
+    // The kernel's share of a slow client's backlog bounded too (no autotuning to MBs of
+    // reports seconds old): about client_buffer_bytes (the kernel doubles the value).
+    const int sndbuf =
+        static_cast<int>(std::min<std::size_t>(options.client_buffer_bytes / 2, 1 << 24));
+    ::setsockopt(c.fd, SOL_SOCKET, SO_SNDBUF, &sndbuf, sizeof sndbuf);
     std::uint8_t buf[kCookieBytes + message_bytes(4 + kMaxNameBytes)];
     write_cookie(buf);
     (void)append(c, buf, kCookieBytes, now);

@@ -10,7 +10,8 @@
 //     at once (TCP) or ignored (UDP request) and counted (clients_refused);
 //   - on connecting, the server sends its cookie, one sender description per body and
 //     the type descriptions; reports go only to clients whose cookie arrived;
-//   - each client has a preallocated output buffer (client_buffer_bytes): a frame's
+//   - each client has a preallocated output buffer (client_buffer_bytes; its socket's
+//     kernel send buffer is set to about as much): a frame's
 //     reports that do not fit are dropped for that client (frames_dropped); a client
 //     whose pending bytes make no progress for stall_ms is disconnected (stalled);
 //   - a client that asked for UDP data (UDP description) gets the reports by UDP
