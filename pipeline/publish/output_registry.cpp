@@ -9,6 +9,7 @@ namespace mocap::publish {
 // One declaration + one table line per output (each defined in its own file).
 extern const OutputKind kUdpOutput;      // udp_sink.cpp
 extern const OutputKind kIceoryxOutput;  // iceoryx_sink.cpp
+extern const OutputKind kVrpnOutput;     // vrpn/vrpn_sink.cpp
 #ifdef MOCAP_HAVE_ROS2
 extern const OutputKind kRos2Output;  // ros2/ros2_sink.cpp
 #endif
@@ -20,6 +21,7 @@ const std::vector<OutputKind>& output_kinds() {
   static const std::vector<OutputKind> kinds = {
       kUdpOutput,
       kIceoryxOutput,
+      kVrpnOutput,
 #ifdef MOCAP_HAVE_ROS2
       kRos2Output,
 #endif

@@ -1,10 +1,10 @@
 // `mocap run [--udp HOST:PORT] [--multicast-if ADDR] [--multicast-ttl N] [--duration SECONDS]
 // [--stats FILE] [--stats-interval S] [--rate HZ] [--loop-frames N] [--no-realtime]
-// [--no-iceoryx] [--ros2] [--foxglove [ADDR:]PORT]`: the live tracker (pipeline/). With no
-// configuration it runs on the simulated stereo pair of the built-in scenario (a
-// pre-rendered loop, hal/sim_camera.h) with the simulator's true joint model, and
+// [--no-iceoryx] [--ros2] [--foxglove [ADDR:]PORT] [--vrpn [ADDR:]PORT]`: the live tracker
+// (pipeline/). With no configuration it runs on the simulated stereo pair of the built-in
+// scenario (a pre-rendered loop, hal/sim_camera.h) with the simulator's true joint model, and
 // publishes every frame over UDP (127.0.0.1:7755 by default) and iceoryx, through the
-// outputs of the registry (pipeline/publish/output_registry.h; --ros2, --foxglove).
+// outputs of the registry (pipeline/publish/output_registry.h; --ros2, --foxglove, --vrpn).
 // --duration, SIGINT or
 // SIGTERM stop it cleanly (the signal handler only sets an atomic flag); it then prints the latency
 // statistics and, with --stats, writes them as JSON. While running, every --stats-interval
@@ -79,6 +79,7 @@ struct RunArgs {
   double stats_interval_s = 5.0;  // 0: no periodic report
   bool ros2 = false;              // --ros2
   std::string foxglove;           // --foxglove [ADDR:]PORT
+  std::string vrpn;               // --vrpn [ADDR:]PORT
   std::string config;             // --config FILE
   std::string check_config;       // --check-config FILE
 };
@@ -147,6 +148,7 @@ int run_live(const RunArgs& a) {
   service::CliOverrides cli = a.cli;
   if (a.ros2) cli.outputs.emplace_back("ros2", "true");
   if (!a.foxglove.empty()) cli.outputs.emplace_back("foxglove", a.foxglove);
+  if (!a.vrpn.empty()) cli.outputs.emplace_back("vrpn", a.vrpn);
   auto cfg = service::resolve_run_config(a.config, cli);
   if (!cfg) return fail(cfg.error().message);
   // Handlers first: a SIGTERM while the sim loop renders (seconds) must still stop cleanly.
@@ -239,6 +241,9 @@ void register_run(CLI::App& app, int& exit_code) {
   cmd->add_option("--foxglove", args->foxglove,
                   "Serve the Foxglove WebSocket live view on [ADDR:]PORT (default address "
                   "127.0.0.1)");
+  cmd->add_option("--vrpn", args->vrpn,
+                  "Serve VRPN trackers, one per body, on [ADDR:]PORT (default address 127.0.0.1, "
+                  "VRPN's port 3883; docs/vrpn.md)");
   cmd->add_option("--config", args->config,
                   "Run the configuration FILE (cameras, rig, stages, outputs, thresholds; "
                   "docs/operations.md); flags given here override it");

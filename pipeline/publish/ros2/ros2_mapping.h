@@ -12,6 +12,7 @@
 
 #include "core/expected.h"
 #include "formats/joints_yaml.h"
+#include "pipeline/publish/capture_clock.h"
 
 namespace mocap::publish::ros2 {
 
@@ -28,8 +29,8 @@ std::vector<JointDof> joint_dofs(const JointModel& model, int max_joints);
 // `value` is the variable's text or null.
 Expected<std::uint32_t> parse_domain_id(const char* value);
 
-// CLOCK_REALTIME - CLOCK_MONOTONIC in ns, measured now (the tightest of a few readings).
-std::int64_t realtime_offset_ns() noexcept;
+// CLOCK_REALTIME - CLOCK_MONOTONIC in ns (pipeline/publish/capture_clock.h, shared with VRPN).
+using mocap::publish::realtime_offset_ns;
 
 struct Stamp {
   std::int32_t sec = 0;
