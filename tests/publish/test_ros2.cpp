@@ -58,10 +58,6 @@ void fill(FrameResult& f, std::uint64_t seq) {
   }
 }
 
-std::unique_ptr<OutputSink> make_sink(std::uint32_t domain, const Fixture& fx) {
-  return ros2_test::make_sink(domain, fx.targets, &fx.model);
-}
-
 TEST(Ros2Mapping, NamesAsTheUrdfAndDomainAndStamp) {
   Fixture fx;
   const auto dofs = ros2::joint_dofs(fx.model, 32);
@@ -127,7 +123,7 @@ TEST(Ros2Output, ReaderReceivesEveryMessageWithRos2NamesAndValues) {
   const std::uint32_t domain = test_domain(0);
   Reader reader(domain);
   ASSERT_TRUE(reader.ok());
-  auto sink = make_sink(domain, fx);
+  auto sink = make_sink(domain, fx.targets, &fx.model);
   ASSERT_NE(sink, nullptr);
   ASSERT_TRUE(reader.wait_matched());
   std::this_thread::sleep_for(std::chrono::milliseconds(200));  // writer side matches too
@@ -212,7 +208,7 @@ TEST(Ros2Output, StalledReaderNeverStallsPublish) {
   const std::uint32_t domain = test_domain(1);
   Reader reader(domain);  // matched, but never takes
   ASSERT_TRUE(reader.ok());
-  auto sink = make_sink(domain, fx);
+  auto sink = make_sink(domain, fx.targets, &fx.model);
   ASSERT_NE(sink, nullptr);
   ASSERT_TRUE(reader.wait_matched());
   auto frame = std::make_unique<FrameResult>();
@@ -258,7 +254,7 @@ TEST(Ros2Output, ThirtyTwoBodiesReachTfAndJointStates) {
   const std::uint32_t domain = test_domain(2);
   Reader reader(domain);
   ASSERT_TRUE(reader.ok());
-  auto sink = make_sink(domain, fx);
+  auto sink = make_sink(domain, fx.targets, &fx.model);
   ASSERT_NE(sink, nullptr);
   ASSERT_TRUE(reader.wait_matched());
   std::this_thread::sleep_for(std::chrono::milliseconds(200));
