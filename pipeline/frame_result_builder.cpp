@@ -3,6 +3,7 @@
 #include "pipeline/frame_result_builder.h"
 
 #include <algorithm>
+#include <bitset>
 #include <cmath>
 #include <numbers>
 
@@ -116,6 +117,19 @@ void make_frame_result(std::uint64_t sequence, std::int64_t capture_ns, const Ta
                     static_cast<float>(l.X_world_mm.z())};
   }
   result.marker_count = markers;
+  // Which of result.points a body claimed (ResultPoint::labelled; ROS 2's unlabelled
+  // cloud is the rest). result.points skips the points that are not reported, so the
+  // claimed out.points indices are mapped by walking both lists in step.
+  std::bitset<publish::kMaxResultPoints> claimed;
+  for (int i = 0; i < labelled.count; ++i) {
+    const int p = labelled.items[static_cast<std::size_t>(i)].point;
+    if (p >= 0 && p < publish::kMaxResultPoints) claimed[static_cast<std::size_t>(p)] = true;
+  }
+  for (int p = 0, r = 0; p < out.points.size() && r < points; ++p) {
+    if (!out.points[p].reported) continue;
+    result.points[static_cast<std::size_t>(r++)].labelled =
+        p < publish::kMaxResultPoints && claimed[static_cast<std::size_t>(p)] ? 1 : 0;
+  }
 
   // Each camera's blobs, and what they became: a labelled marker, a point, or nothing.
   const int cameras = std::min(static_cast<int>(out.blobs.size()), publish::kMaxResultCameras);

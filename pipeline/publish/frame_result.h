@@ -50,9 +50,11 @@ struct ResultMarker {
 struct ResultPoint {
   std::array<float, 3> X_world_mm{{0, 0, 0}};
   float reproj_px = 0.0f;
-  std::uint8_t cameras = 0;  // how many cameras saw the point
-  std::uint8_t reserved[3] = {0, 0, 0};
+  std::uint8_t cameras = 0;   // how many cameras saw the point
+  std::uint8_t labelled = 0;  // 1: a body claimed it (it is one of the labelled markers)
+  std::uint8_t reserved[2] = {0, 0};
 };
+static_assert(sizeof(ResultPoint) == 20, "ResultPoint keeps its size (labelled was reserved)");
 
 // What a blob became in this frame.
 enum class BlobUse : std::uint8_t {

@@ -237,7 +237,8 @@ void register_run(CLI::App& app, int& exit_code) {
   cmd->add_flag("--no-iceoryx", args->cli.no_iceoryx, "Do not publish over iceoryx shared memory");
   cmd->add_flag(
       "--ros2", args->ros2,
-      "Publish /joint_states and /tf over DDS as ROS 2 does (ROS_DOMAIN_ID; docs/ros2.md)");
+      "Publish /joint_states, /tf, /mocap/<body>/pose and /mocap/unlabeled_markers over DDS "
+      "as ROS 2 does (ROS_DOMAIN_ID; docs/ros2.md)");
   cmd->add_option("--foxglove", args->foxglove,
                   "Serve the Foxglove WebSocket live view on [ADDR:]PORT (default address "
                   "127.0.0.1)");

@@ -3,7 +3,8 @@
 // the datagram expects them (validity, angles, quality solved-by), the found body's pose
 // as qw>=0 quaternion + translation, its labelled markers with the residual to the
 // posed model marker (unmatched markers left out), the points with reprojection error
-// and camera count, and each camera's blobs with what they became; no allocation.
+// and camera count, and each camera's blobs with what they became; which points a body
+// claimed (ResultPoint::labelled, also behind points that are not reported); no allocation.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -181,6 +182,55 @@ TEST(FrameResultBuilder, BlobsSayWhatTheyBecame) {
   EXPECT_EQ(use(0, 2), BlobUse::kUnused);
   EXPECT_EQ(use(1, 1), BlobUse::kUnused);
   EXPECT_EQ(use(0, 3), BlobUse::kUnused);
+}
+
+// ResultPoint::labelled: the points a body claimed, mapped through the points that are
+// not reported (result.points skips them): out.points = {lost, marker 0, stray, marker
+// 2} -> result.points = {marker 0: 1, stray: 0, marker 2: 1}; a reused result is reset.
+TEST(FrameResultBuilder, PointsSayWhetherABodyClaimedThem) {
+  TargetSet targets;
+  MarkerTarget t;
+  t.name = "torso";
+  t.markers_body = {Vec3(0, 0, 0), Vec3(40, 0, 0), Vec3(0, 50, 0)};
+  targets.bodies.push_back(t);
+  auto out = std::make_unique<FrameOutput>();
+  out->points.set_capacity(4);
+  Iso3 T = Iso3::Identity();
+  T.translate(Vec3(0, 0, 1000));
+  Point3 p;
+  p.reported = false;  // a candidate that lost its blobs to a better one
+  p.X_world = Vec3(1, 1, 1);
+  ASSERT_TRUE(out->points.push_back(p));
+  p.reported = true;
+  for (const Vec3& X : {T * t.markers_body[0], Vec3(500, 0, 900), T * t.markers_body[2]}) {
+    p.X_world = X;
+    ASSERT_TRUE(out->points.push_back(p));
+  }
+  out->poses.count = 1;
+  out->poses.found = 1;
+  BodyPose& b0 = out->poses.bodies[0];
+  b0.found = true;
+  b0.T_world_body = T;
+  b0.markers = 2;
+  b0.point_index_of_marker.fill(-1);
+  b0.point_index_of_marker[0] = 1;
+  b0.point_index_of_marker[2] = 3;
+
+  auto r = std::make_unique<publish::FrameResult>();
+  for (publish::ResultPoint& rp : r->points) rp.labelled = 1;  // the slot's previous frame
+  auto labelled = std::make_unique<LabelledMarkers>();
+  {
+    test::AllocationScope scope;
+    make_frame_result(1, 0, targets, *out, *labelled, *r);
+    EXPECT_EQ(scope.count(), 0u);
+  }
+  ASSERT_EQ(r->point_count, 3);
+  ASSERT_EQ(r->marker_count, 2);
+  EXPECT_EQ(r->points[0].labelled, 1);
+  EXPECT_FLOAT_EQ(r->points[1].X_world_mm[0], 500.0f);
+  EXPECT_EQ(r->points[1].labelled, 0);
+  EXPECT_EQ(r->points[2].labelled, 1);
+  EXPECT_FLOAT_EQ(r->points[2].X_world_mm[1], 50.0f);
 }
 
 }  // namespace

@@ -12,7 +12,6 @@
 #include <dds/dds.h>
 #include <gtest/gtest.h>
 #include <time.h>
-#include <unistd.h>
 
 #include <chrono>
 #include <cmath>
@@ -25,48 +24,13 @@
 #include "pipeline/publish/output_registry.h"
 #include "pipeline/publish/ros2/ros2_mapping.h"
 #include "ros2_msgs.h"
+#include "tests/publish/ros2_test_reader.h"
 
 namespace mocap::publish {
 namespace {
 
-std::int64_t now_ns(clockid_t c) {
-  timespec ts{};
-  clock_gettime(c, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
-
-// A domain of its own per process (and per test: offset), to avoid cross-talk.
-std::uint32_t test_domain(int offset) {
-  return static_cast<std::uint32_t>(100 + (::getpid() * 3 + offset) % 120);
-}
-
-struct Fixture {
-  TargetSet targets;
-  JointModel model;
-  Fixture() {
-    for (const char* n : {"torso", "upper_arm", "forearm"}) {
-      MarkerTarget t;
-      t.name = n;
-      t.markers_body = {Vec3(0, 0, 0), Vec3(50, 0, 0), Vec3(0, 60, 0)};
-      targets.bodies.push_back(t);
-    }
-    JointSpec shoulder;
-    shoulder.name = "shoulder";
-    shoulder.type = JointType::kBall;
-    shoulder.parent = "torso";
-    shoulder.child = "upper_arm";
-    shoulder.parent_index = 0;
-    shoulder.child_index = 1;
-    JointSpec elbow = shoulder;
-    elbow.name = "elbow";
-    elbow.type = JointType::kHinge;
-    elbow.parent = "upper_arm";
-    elbow.child = "forearm";
-    elbow.parent_index = 1;
-    elbow.child_index = 2;
-    model.joints = {shoulder, elbow};
-  }
-};
+using namespace ros2_test;  // Reader, take_all, test_domain, now_ns, make_sink
+using Fixture = ArmFixture;
 
 void fill(FrameResult& f, std::uint64_t seq) {
   f = FrameResult{};
@@ -92,76 +56,6 @@ void fill(FrameResult& f, std::uint64_t seq) {
     const double h = 0.05 * static_cast<double>(seq);
     f.bodies[b].q_world_body = {std::cos(h), 0.0, 0.0, std::sin(h)};
   }
-}
-
-class Reader {
- public:
-  explicit Reader(std::uint32_t domain) {
-    participant_ = dds_create_participant(domain, nullptr, nullptr);
-    dds_qos_t* qos = dds_create_qos();
-    dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
-    dds_qset_history(qos, DDS_HISTORY_KEEP_ALL, 0);
-    js_ = reader(qos, &sensor_msgs_msg_dds__JointState__desc, "rt/joint_states");
-    tf_ = reader(qos, &tf2_msgs_msg_dds__TFMessage__desc, "rt/tf");
-    dds_qset_durability(qos, DDS_DURABILITY_TRANSIENT_LOCAL);
-    desc_ = reader(qos, &std_msgs_msg_dds__String__desc, "rt/robot_description");
-    dds_delete_qos(qos);
-  }
-  ~Reader() {
-    if (participant_ > 0) dds_delete(participant_);
-  }
-  bool ok() const { return participant_ > 0 && js_ > 0 && tf_ > 0 && desc_ > 0; }
-  // Waits until both data readers matched a writer.
-  bool wait_matched() {
-    for (int i = 0; i < 500; ++i) {
-      dds_subscription_matched_status_t a{}, b{};
-      dds_get_subscription_matched_status(js_, &a);
-      dds_get_subscription_matched_status(tf_, &b);
-      if (a.current_count > 0 && b.current_count > 0) return true;
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
-    return false;
-  }
-  dds_entity_t js_ = 0, tf_ = 0, desc_ = 0;
-
- private:
-  dds_entity_t reader(const dds_qos_t* qos, const dds_topic_descriptor_t* d, const char* name) {
-    const dds_entity_t t = dds_create_topic(participant_, d, name, nullptr, nullptr);
-    return t < 0 ? t : dds_create_reader(participant_, t, qos, nullptr);
-  }
-  dds_entity_t participant_ = 0;
-};
-
-template <class T>
-std::vector<T*> take_all(dds_entity_t reader, std::vector<void*>& loans) {
-  std::vector<T*> out;
-  void* samples[64];
-  dds_sample_info_t infos[64];
-  for (;;) {
-    for (void*& s : samples) s = nullptr;
-    const dds_return_t n = dds_take(reader, samples, infos, 64, 64);
-    if (n <= 0) break;
-    for (int i = 0; i < n; ++i) {
-      if (infos[i].valid_data) out.push_back(static_cast<T*>(samples[i]));
-      loans.push_back(samples[i]);
-    }
-    if (n < 64) break;
-  }
-  return out;
-}
-
-std::unique_ptr<OutputSink> make_sink(std::uint32_t domain, const Fixture& fx) {
-  OutputContext ctx;
-  ctx.targets = &fx.targets;
-  ctx.model = &fx.model;
-  auto outs = create_outputs(
-      {{"ros2", {"true"}, "test: outputs.ros2", {{"domain_id", std::to_string(domain)}}}}, ctx);
-  if (!outs.ok() || outs->sinks.size() != 1) {
-    ADD_FAILURE() << (outs.ok() ? "no sink: " + (outs->notices.empty() ? "" : outs->notices[0])
-                                : outs.error().message);
-    return nullptr;
-  }
-  return std::move(outs->sinks[0]);
 }
 
 TEST(Ros2Mapping, NamesAsTheUrdfAndDomainAndStamp) {
@@ -229,7 +123,7 @@ TEST(Ros2Output, ReaderReceivesEveryMessageWithRos2NamesAndValues) {
   const std::uint32_t domain = test_domain(0);
   Reader reader(domain);
   ASSERT_TRUE(reader.ok());
-  auto sink = make_sink(domain, fx);
+  auto sink = make_sink(domain, fx.targets, &fx.model);
   ASSERT_NE(sink, nullptr);
   ASSERT_TRUE(reader.wait_matched());
   std::this_thread::sleep_for(std::chrono::milliseconds(200));  // writer side matches too
@@ -314,7 +208,7 @@ TEST(Ros2Output, StalledReaderNeverStallsPublish) {
   const std::uint32_t domain = test_domain(1);
   Reader reader(domain);  // matched, but never takes
   ASSERT_TRUE(reader.ok());
-  auto sink = make_sink(domain, fx);
+  auto sink = make_sink(domain, fx.targets, &fx.model);
   ASSERT_NE(sink, nullptr);
   ASSERT_TRUE(reader.wait_matched());
   auto frame = std::make_unique<FrameResult>();
@@ -360,7 +254,7 @@ TEST(Ros2Output, ThirtyTwoBodiesReachTfAndJointStates) {
   const std::uint32_t domain = test_domain(2);
   Reader reader(domain);
   ASSERT_TRUE(reader.ok());
-  auto sink = make_sink(domain, fx);
+  auto sink = make_sink(domain, fx.targets, &fx.model);
   ASSERT_NE(sink, nullptr);
   ASSERT_TRUE(reader.wait_matched());
   std::this_thread::sleep_for(std::chrono::milliseconds(200));

@@ -8,86 +8,38 @@
 // hinges), listed in model order (hinge J; ball J_x, J_y, J_z) with the tracker's angles, and
 // the /tf child frames are exactly its 15 body links, posed in metres. (The 32-body
 // capacity with synthetic names: test_ros2.cpp, Ros2Output.ThirtyTwoBodiesReachTfAndJointStates.)
+// The 2027-01 additions at this scale: /mocap/<body>/pose of all 15 bodies equals their
+// /tf transforms, and /mocap/unlabeled_markers holds exactly the frame's two strays.
 #include <dds/dds.h>
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <set>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "pipeline/publish/output_registry.h"
+#include "pipeline/publish/ros2/ros2_mapping.h"
 #include "ros2_msgs.h"
 #include "tests/pipeline/humanoid_frame.h"
+#include "tests/publish/ros2_test_reader.h"
 
 namespace mocap::publish {
 namespace {
 
-std::uint32_t test_domain() { return static_cast<std::uint32_t>(100 + (::getpid() * 3 + 7) % 120); }
-
-class Reader {
- public:
-  explicit Reader(std::uint32_t domain) {
-    participant_ = dds_create_participant(domain, nullptr, nullptr);
-    dds_qos_t* qos = dds_create_qos();
-    dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
-    dds_qset_history(qos, DDS_HISTORY_KEEP_ALL, 0);
-    js_ = reader(qos, &sensor_msgs_msg_dds__JointState__desc, "rt/joint_states");
-    tf_ = reader(qos, &tf2_msgs_msg_dds__TFMessage__desc, "rt/tf");
-    dds_qset_durability(qos, DDS_DURABILITY_TRANSIENT_LOCAL);
-    desc_ = reader(qos, &std_msgs_msg_dds__String__desc, "rt/robot_description");
-    dds_delete_qos(qos);
-  }
-  ~Reader() {
-    if (participant_ > 0) dds_delete(participant_);
-  }
-  bool ok() const { return participant_ > 0 && js_ > 0 && tf_ > 0 && desc_ > 0; }
-  bool wait_matched() {
-    for (int i = 0; i < 500; ++i) {
-      dds_subscription_matched_status_t a{}, b{}, c{};
-      dds_get_subscription_matched_status(js_, &a);
-      dds_get_subscription_matched_status(tf_, &b);
-      dds_get_subscription_matched_status(desc_, &c);
-      if (a.current_count > 0 && b.current_count > 0 && c.current_count > 0) return true;
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
-    return false;
-  }
-  // One sample of `reader` (waits up to 3 s); the loan is returned by the caller.
-  template <class T>
-  T* take_one(dds_entity_t reader, void*& loan) {
-    for (int i = 0; i < 300; ++i) {
-      void* samples[1] = {nullptr};
-      dds_sample_info_t info[1];
-      if (dds_take(reader, samples, info, 1, 1) == 1) {
-        loan = samples[0];
-        if (info[0].valid_data) return static_cast<T*>(samples[0]);
-        dds_return_loan(reader, samples, 1);
-        continue;
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
-    return nullptr;
-  }
-  dds_entity_t js_ = 0, tf_ = 0, desc_ = 0;
-
- private:
-  dds_entity_t reader(const dds_qos_t* qos, const dds_topic_descriptor_t* d, const char* name) {
-    const dds_entity_t t = dds_create_topic(participant_, d, name, nullptr, nullptr);
-    return t < 0 ? t : dds_create_reader(participant_, t, qos, nullptr);
-  }
-  dds_entity_t participant_ = 0;
-};
+using namespace ros2_test;  // Reader, take_one, test_domain
 
 TEST(Ros2Humanoid, JointStatesAndTfAreNamedAsTheUrdf) {
   auto h = testing::make_humanoid_frame(3, 21);
   const sim::SimScene& sc = h->scene;
   ASSERT_EQ(sc.body_count(), 15);
-  const std::uint32_t domain = test_domain();
-  Reader reader(domain);
+  const std::uint32_t domain = test_domain(7);
+  std::vector<std::string> tokens;  // /mocap/<body>/pose of every body
+  for (const MarkerTarget& b : sc.targets.bodies) tokens.push_back(ros2::topic_token(b.name));
+  Reader reader(domain, tokens);
   ASSERT_TRUE(reader.ok());
   OutputContext ctx;
   ctx.targets = &sc.targets;
@@ -97,12 +49,12 @@ TEST(Ros2Humanoid, JointStatesAndTfAreNamedAsTheUrdf) {
   ASSERT_TRUE(outs.ok()) << outs.error().message;
   ASSERT_EQ(outs->sinks.size(), 1u) << (outs->notices.empty() ? "" : outs->notices[0]);
   OutputSink& sink = *outs->sinks[0];
-  ASSERT_TRUE(reader.wait_matched());
+  ASSERT_TRUE(reader.wait_matched(true));
   std::this_thread::sleep_for(std::chrono::milliseconds(200));  // the writers match too
 
   // The URDF as ROS nodes get it: its revolute joints and its links.
   void* desc_loan = nullptr;
-  auto* desc = reader.take_one<std_msgs_msg_dds__String_>(reader.desc_, desc_loan);
+  auto* desc = take_one<std_msgs_msg_dds__String_>(reader.desc_, desc_loan);
   ASSERT_NE(desc, nullptr) << "no robot_description";
   const std::string urdf = desc->data;
   dds_return_loan(reader.desc_, &desc_loan, 1);
@@ -131,8 +83,8 @@ TEST(Ros2Humanoid, JointStatesAndTfAreNamedAsTheUrdf) {
   ASSERT_TRUE(sink.publish(*frame));
   void* js_loan = nullptr;
   void* tf_loan = nullptr;
-  auto* js = reader.take_one<sensor_msgs_msg_dds__JointState_>(reader.js_, js_loan);
-  auto* tf = reader.take_one<tf2_msgs_msg_dds__TFMessage_>(reader.tf_, tf_loan);
+  auto* js = take_one<sensor_msgs_msg_dds__JointState_>(reader.js_, js_loan);
+  auto* tf = take_one<tf2_msgs_msg_dds__TFMessage_>(reader.tf_, tf_loan);
   ASSERT_NE(js, nullptr);
   ASSERT_NE(tf, nullptr);
   ASSERT_EQ(js->name._length, 30u);
@@ -170,6 +122,38 @@ TEST(Ros2Humanoid, JointStatesAndTfAreNamedAsTheUrdf) {
                 1.0, 1e-9);
   }
   for (const MarkerTarget& b : sc.targets.bodies) EXPECT_TRUE(children.count(b.name)) << b.name;
+  // /mocap/<body>/pose of every body (all found): the /tf pose, frame "mocap", metres.
+  for (std::size_t b = 0; b < tokens.size(); ++b) {
+    void* loan = nullptr;
+    auto* p = take_one<geometry_msgs_msg_dds__PoseStamped_>(reader.poses_[b], loan);
+    ASSERT_NE(p, nullptr) << "no /mocap/" << tokens[b] << "/pose";
+    const auto& t = tf->transforms._buffer[b];
+    EXPECT_STREQ(t.child_frame_id, sc.targets.bodies[b].name.c_str());
+    EXPECT_STREQ(p->header.frame_id, "mocap");
+    EXPECT_EQ(p->header.stamp.sec, t.header.stamp.sec);
+    EXPECT_EQ(p->header.stamp.nanosec, t.header.stamp.nanosec);
+    EXPECT_EQ(p->pose.position.x, t.transform.translation.x) << tokens[b];
+    EXPECT_EQ(p->pose.position.y, t.transform.translation.y);
+    EXPECT_EQ(p->pose.position.z, t.transform.translation.z);
+    EXPECT_EQ(p->pose.orientation.w, t.transform.rotation.w);
+    EXPECT_EQ(p->pose.orientation.x, t.transform.rotation.x);
+    EXPECT_EQ(p->pose.orientation.y, t.transform.rotation.y);
+    EXPECT_EQ(p->pose.orientation.z, t.transform.rotation.z);
+    dds_return_loan(reader.poses_[b], &loan, 1);
+  }
+  // /mocap/unlabeled_markers: of the 71 markers and 2 strays only the strays (the
+  // pipeline's make_frame_result decided which points the bodies claimed), in metres.
+  void* cloud_loan = nullptr;
+  auto* cloud = take_one<sensor_msgs_msg_dds__PointCloud2_>(reader.cloud_, cloud_loan);
+  ASSERT_NE(cloud, nullptr);
+  ASSERT_EQ(frame->point_count, 73);
+  ASSERT_EQ(cloud->width, 2u);
+  ASSERT_EQ(cloud->data._length, 24u);
+  float xyz[6];
+  std::memcpy(xyz, cloud->data._buffer, sizeof xyz);
+  const double strays[6] = {-0.7, 0.3, 0.4, 0.65, -0.2, 1.7};
+  for (int k = 0; k < 6; ++k) EXPECT_NEAR(xyz[k], strays[k], 1e-6) << k;
+  dds_return_loan(reader.cloud_, &cloud_loan, 1);
   dds_return_loan(reader.js_, &js_loan, 1);
   dds_return_loan(reader.tf_, &tf_loan, 1);
 }

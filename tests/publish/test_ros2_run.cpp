@@ -6,18 +6,28 @@
 // datagrams' angles (frames aligned by capture time: stamp - capture_ns is one constant
 // offset), the names are the revolute joints of the URDF the tracker publishes on
 // /robot_description (transient local), and the run reports the ros2 counters.
+// The 2027-01 additions (the acceptance of issue 30 item 5): every /joint_states entry has
+// a velocity (rad/s; NaN only while a rate is not known yet, and most are known), every
+// body /tf names gets /mocap/<body>/pose messages (readers made as soon as /tf names the
+// bodies) equal to its /tf transforms of the same frames, for at least 95 % of the frames
+// after they matched, and /mocap/unlabeled_markers arrives with every frame.
 #include <dds/dds.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <array>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <map>
+#include <set>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "client/datagram.h"
+#include "pipeline/publish/ros2/ros2_mapping.h"
 #include "ros2_msgs.h"
 #include "tests/support/test_support.h"
 #include "tests/support/udp_port.h"
@@ -29,7 +39,16 @@ struct JsRecord {
   std::int64_t stamp_ns = 0;
   std::vector<std::string> names;
   std::vector<double> positions;
+  std::vector<double> velocities;
 };
+
+// A pose as /tf and /mocap/<body>/pose carry it: stamp, x y z, qw qx qy qz.
+using PoseKey = std::pair<std::string, std::int64_t>;  // body, stamp
+using PoseValues = std::array<double, 7>;
+
+std::int64_t stamp_of(const builtin_interfaces_msg_dds__Time_& t) {
+  return static_cast<std::int64_t>(t.sec) * 1'000'000'000 + t.nanosec;
+}
 
 TEST(Ros2Run, TrackerPublishesEveryFrameOnJointStatesAndTf) {
   const std::uint32_t domain = static_cast<std::uint32_t>(10 + ::getpid() % 80);
@@ -56,8 +75,17 @@ TEST(Ros2Run, TrackerPublishesEveryFrameOnJointStatesAndTf) {
                         dds_create_topic(pp, &std_msgs_msg_dds__String__desc,
                                          "rt/robot_description", nullptr, nullptr),
                         qos, nullptr);
-  dds_delete_qos(qos);
+  dds_qset_durability(qos, DDS_DURABILITY_VOLATILE);
+  const dds_entity_t cloud =
+      dds_create_reader(pp,
+                        dds_create_topic(pp, &sensor_msgs_msg_dds__PointCloud2__desc,
+                                         "rt/mocap/unlabeled_markers", nullptr, nullptr),
+                        qos, nullptr);
   ASSERT_GT(desc, 0);
+  ASSERT_GT(cloud, 0);
+  std::map<std::string, dds_entity_t> pose_readers;  // body -> reader, once /tf names it
+  std::map<PoseKey, PoseValues> tf_poses, pose_msgs;
+  std::size_t clouds = 0;
   std::string urdf;
   ASSERT_GT(js, 0);
   ASSERT_GT(tf, 0);
@@ -101,9 +129,11 @@ TEST(Ros2Run, TrackerPublishesEveryFrameOnJointStatesAndTf) {
         JsRecord r;
         r.stamp_ns = static_cast<std::int64_t>(m->header.stamp.sec) * 1'000'000'000 +
                      m->header.stamp.nanosec;
+        EXPECT_EQ(m->velocity._length, m->name._length);
         for (std::uint32_t k = 0; k < m->name._length; ++k) {
           r.names.emplace_back(m->name._buffer[k]);
           r.positions.push_back(m->position._buffer[k]);
+          if (k < m->velocity._length) r.velocities.push_back(m->velocity._buffer[k]);
         }
         states.push_back(std::move(r));
       }
@@ -118,10 +148,54 @@ TEST(Ros2Run, TrackerPublishesEveryFrameOnJointStatesAndTf) {
         const auto* m = static_cast<const tf2_msgs_msg_dds__TFMessage_*>(samples[i]);
         ++tf_count;
         tf_transforms += m->transforms._length;
-        for (std::uint32_t k = 0; k < m->transforms._length; ++k)
-          EXPECT_STREQ(m->transforms._buffer[k].header.frame_id, "mocap");
+        for (std::uint32_t k = 0; k < m->transforms._length; ++k) {
+          const auto& x = m->transforms._buffer[k];
+          EXPECT_STREQ(x.header.frame_id, "mocap");
+          const auto& t = x.transform.translation;
+          const auto& q = x.transform.rotation;
+          tf_poses[{x.child_frame_id, stamp_of(x.header.stamp)}] = {t.x, t.y, t.z, q.w,
+                                                                    q.x, q.y, q.z};
+          if (pose_readers.count(x.child_frame_id) == 0) {
+            const std::string topic =
+                "rt/mocap/" + publish::ros2::topic_token(x.child_frame_id) + "/pose";
+            pose_readers[x.child_frame_id] =
+                dds_create_reader(pp,
+                                  dds_create_topic(pp, &geometry_msgs_msg_dds__PoseStamped__desc,
+                                                   topic.c_str(), nullptr, nullptr),
+                                  qos, nullptr);
+          }
+        }
       }
       dds_return_loan(tf, samples, n);
+    }
+    for (const auto& [body, reader] : pose_readers) {
+      for (;;) {
+        for (void*& s : samples) s = nullptr;
+        const dds_return_t n = dds_take(reader, samples, infos, 32, 32);
+        if (n <= 0) break;
+        for (int i = 0; i < n; ++i) {
+          if (!infos[i].valid_data) continue;
+          const auto* m = static_cast<const geometry_msgs_msg_dds__PoseStamped_*>(samples[i]);
+          EXPECT_STREQ(m->header.frame_id, "mocap");
+          const auto& t = m->pose.position;
+          const auto& q = m->pose.orientation;
+          pose_msgs[{body, stamp_of(m->header.stamp)}] = {t.x, t.y, t.z, q.w, q.x, q.y, q.z};
+        }
+        dds_return_loan(reader, samples, n);
+      }
+    }
+    for (;;) {
+      for (void*& s : samples) s = nullptr;
+      const dds_return_t n = dds_take(cloud, samples, infos, 32, 32);
+      if (n <= 0) break;
+      for (int i = 0; i < n; ++i) {
+        if (!infos[i].valid_data) continue;
+        const auto* m = static_cast<const sensor_msgs_msg_dds__PointCloud2_*>(samples[i]);
+        EXPECT_EQ(m->point_step, 12u);
+        EXPECT_EQ(m->data._length, 12u * m->width);
+        ++clouds;
+      }
+      dds_return_loan(cloud, samples, n);
     }
   };
   while (!done && std::chrono::steady_clock::now() < deadline) {
@@ -150,6 +224,7 @@ TEST(Ros2Run, TrackerPublishesEveryFrameOnJointStatesAndTf) {
   }
   tracker.join();
   drain_dds();
+  dds_delete_qos(qos);
   dds_delete(pp);
   ASSERT_EQ(run.exit_code, 0) << run.output;
   ASSERT_TRUE(matched) << run.output;
@@ -160,6 +235,33 @@ TEST(Ros2Run, TrackerPublishesEveryFrameOnJointStatesAndTf) {
       << states.size() << " of " << expected;
   EXPECT_GE(static_cast<double>(tf_count), 0.95 * static_cast<double>(expected));
   EXPECT_GT(tf_transforms, 0u);
+  EXPECT_GE(static_cast<double>(clouds), 0.95 * static_cast<double>(expected)) << clouds;
+  // /mocap/<body>/pose: every body /tf named; each pose is its /tf transform of that frame,
+  // and from its first pose on, at least 95 % of the body's /tf frames have one.
+  ASSERT_FALSE(pose_readers.empty());
+  for (const auto& [body, reader] : pose_readers) {
+    std::int64_t first = -1;
+    std::size_t poses = 0, frames = 0;
+    for (const auto& [key, values] : pose_msgs) {
+      if (key.first != body) continue;
+      if (first < 0 || key.second < first) first = key.second;
+      ++poses;
+      const auto it = tf_poses.find(key);
+      ASSERT_NE(it, tf_poses.end()) << body << ": a pose without its /tf frame";
+      EXPECT_EQ(it->second, values) << body;
+    }
+    EXPECT_GT(poses, 0u) << "no /mocap/" << body << "/pose";
+    for (const auto& [key, values] : tf_poses) frames += key.first == body && key.second >= first;
+    EXPECT_GE(static_cast<double>(poses), 0.95 * static_cast<double>(frames)) << body;
+  }
+  // JointState.velocity for every valid joint: one per entry; known for most entries.
+  std::size_t known = 0, entries = 0;
+  for (const auto& s : states) {
+    EXPECT_EQ(s.velocities.size(), s.positions.size());
+    for (const double v : s.velocities) known += std::isfinite(v) ? 1 : 0;
+    entries += s.velocities.size();
+  }
+  EXPECT_GE(static_cast<double>(known), 0.5 * static_cast<double>(entries));
   ASSERT_FALSE(states.empty());
   // Align: stamp_ns - capture_ns is the same offset for every frame.
   std::map<std::int64_t, const client::JointsMessage*> by_capture;

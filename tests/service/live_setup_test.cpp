@@ -137,9 +137,22 @@ TEST(LiveSetup, RegistryOutputsFromTheFileAndTheFlags) {
   auto with_flag = resolve_run_config(dir.file("opt.yaml"), cli);  // --ros2 keeps domain_id
   ASSERT_TRUE(with_flag) << with_flag.error().message;
   EXPECT_EQ(output_requests(*with_flag, cli)[2].options, (Options{{"domain_id", "7"}}));
-  EXPECT_EQ(
-      error_of("typo.yaml", "{value: false, domain: 7}"),
-      dir.file("typo.yaml") + ": outputs.ros2 (line 2): domain: unknown option (known: domain_id)");
+  EXPECT_EQ(error_of("typo.yaml", "{value: false, domain: 7}"),
+            dir.file("typo.yaml") +
+                ": outputs.ros2 (line 2): domain: unknown option (known: domain_id frame_id "
+                "world_rotation)");
+  // The 2027-01 options: a frame id and a world rotation, checked with one line naming it.
+  test::write_file(
+      dir.file("rot.yaml"),
+      "outputs:\n  ros2: {value: true, frame_id: odom, world_rotation: \"0 0 0 1\"}\n");
+  auto rot = resolve_run_config(dir.file("rot.yaml"), CliOverrides{});
+  ASSERT_TRUE(rot) << rot.error().message;
+  EXPECT_EQ(rot->outputs.more[0].options,
+            (Options{{"frame_id", "odom"}, {"world_rotation", "0 0 0 1"}}));
+  EXPECT_EQ(error_of("enu.yaml", "{value: true, world_rotation: enu}"),
+            dir.file("enu.yaml") +
+                ": outputs.ros2 (line 2): world_rotation: expected identity, camera_to_z_up, "
+                "y_up_to_z_up or a unit quaternion 'qw qx qy qz', got 'enu'");
   const std::string deep = error_of("deep.yaml", "{value: false, domain_id: [1]}");
   EXPECT_NE(deep.find("outputs.ros2.domain_id: expected a value, got"), std::string::npos) << deep;
 }
