@@ -7,7 +7,7 @@
 // 95 % of the frames the datagrams carry while the client was connected; each report's time is a
 // frame's capture time on the system clock (matched to a datagram's CLOCK_MONOTONIC capture time
 // through this machine's realtime - monotonic offset, within 1 ms); quaternions are unit, positions
-// in metres.
+// in metres; Velocity reports (the tracker's body velocities) follow for >= 90 % of them.
 #include <gtest/gtest.h>
 #include <time.h>
 
@@ -92,9 +92,15 @@ TEST(VrpnRun, EveryBodyAtTheFrameRateWithCaptureTimes) {
     ASSERT_GE(client->senders.size(), 2u);
     ASSERT_FALSE(client->reports.empty()) << run.output;
     std::map<std::string, std::set<std::int64_t>> per_body;
+    std::map<std::string, int> velocities;  // Velocity reports per body (the body rates)
     std::int64_t first = INT64_MAX;
     int unmatched = 0, wrong_path = 0;
     for (const auto& r : client->reports) {
+      if (r.type == "vrpn_Tracker Velocity") {
+        ++velocities[r.body];
+        EXPECT_LT(std::fabs(r.vel[0]) + std::fabs(r.vel[1]) + std::fabs(r.vel[2]), 20.0);  // m/s
+        continue;
+      }
       if (r.type != "vrpn_Tracker Pos_Quat") continue;
       wrong_path += !udp && r.via_udp ? 1 : 0;  // the TCP client never asked for UDP
       const std::int64_t t =
@@ -125,6 +131,9 @@ TEST(VrpnRun, EveryBodyAtTheFrameRateWithCaptureTimes) {
                   udp ? "connect-back, UDP" : "TCP", name.c_str(), per_body[name].size(), expected);
       EXPECT_GE(static_cast<double>(per_body[name].size()), 0.95 * expected)
           << name << ": " << per_body[name].size() << " of " << expected << " frames";
+      // Velocities from the third frame a body is found on (kinematics/body_rates.h).
+      EXPECT_GE(static_cast<double>(velocities[name]), 0.9 * expected)
+          << name << ": " << velocities[name] << " Velocity reports";
     }
   }
 }
