@@ -1,7 +1,7 @@
 // Test support of the ROS 2 output's tests (test_ros2*.cpp): an independent Cyclone DDS
 // subscriber written against the ROS 2 IDL (pipeline/publish/ros2/ros2_msgs.idl) with
 // ROS 2's names, as a ROS 2 node subscribes: reliable, keep-all readers of
-// rt/joint_states, rt/tf, rt/mocap/unlabeled_markers, rt/mocap/<body>/pose for the
+// rt/joint_states, rt/tf, rt/mocap/unlabeled_markers, rt/mocap/<body>/pose and /twist for the
 // bodies asked for, and rt/robot_description (transient local); helpers that take every
 // sample or one; a DDS domain of its own per test process; the 3-body arm fixture and
 // the registry's "ros2" sink on a domain with extra options.
@@ -49,6 +49,9 @@ class Reader {
     for (const std::string& b : pose_bodies) {
       const std::string topic = "rt/mocap/" + b + "/pose";
       poses_.push_back(reader(qos, &geometry_msgs_msg_dds__PoseStamped__desc, topic.c_str()));
+      const std::string twist = "rt/mocap/" + b + "/twist";
+      twists_.push_back(
+          reader(qos, &geometry_msgs_msg_dds__TwistStamped__desc, twist.c_str()));
     }
     dds_qset_durability(qos, DDS_DURABILITY_TRANSIENT_LOCAL);
     desc_ = reader(qos, &std_msgs_msg_dds__String__desc, "rt/robot_description");
@@ -63,6 +66,7 @@ class Reader {
   bool ok() const {
     bool ok = participant_ > 0 && js_ > 0 && tf_ > 0 && cloud_ > 0 && desc_ > 0;
     for (const dds_entity_t p : poses_) ok = ok && p > 0;
+    for (const dds_entity_t t : twists_) ok = ok && t > 0;
     return ok;
   }
   // Waits until every data reader matched a writer (robot_description only when asked:
@@ -72,13 +76,15 @@ class Reader {
       bool all =
           matched(js_) && matched(tf_) && matched(cloud_) && (!description || matched(desc_));
       for (const dds_entity_t p : poses_) all = all && matched(p);
+      for (const dds_entity_t t : twists_) all = all && matched(t);
       if (all) return true;
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
     }
     return false;
   }
   dds_entity_t js_ = 0, tf_ = 0, cloud_ = 0, desc_ = 0;
-  std::vector<dds_entity_t> poses_;  // in the order of `pose_bodies`
+  std::vector<dds_entity_t> poses_;   // in the order of `pose_bodies`
+  std::vector<dds_entity_t> twists_;  // rt/mocap/<body>/twist, likewise
 
  private:
   static bool matched(dds_entity_t reader) {

@@ -1,5 +1,6 @@
 // The ROS 2 additions (interfaces.md, "ROS 2 additions"; docs/ros2.md): the registry's
-// "ros2" sink publishes /mocap/<body>/pose (geometry_msgs/PoseStamped) for every body
+// "ros2" sink publishes /mocap/<body>/pose (geometry_msgs/PoseStamped) and, when its
+// velocities are known, /mocap/<body>/twist (geometry_msgs/TwistStamped) for every body
 // found and /mocap/unlabeled_markers (sensor_msgs/PointCloud2) of the points no body
 // claimed, and an independent Cyclone DDS reader with ROS 2's names
 // (ros2_test_reader.h) checks: each pose equals the body's /tf transform (metres, frame
@@ -48,6 +49,10 @@ void fill_additions(FrameResult& f, std::uint64_t seq) {
     body.t_world_body_mm = {100.0 * b + static_cast<double>(seq), -20.0 * b, 1500.0};
     const double h = 0.1 * static_cast<double>(seq) + 0.3 * b;
     body.q_world_body = {std::cos(h), std::sin(h) * 0.6, 0.0, std::sin(h) * 0.8};
+    // Velocities known for the torso from the second frame on (the filter's warm-up).
+    body.velocity_valid = b == 0 && seq >= 2 ? 1 : 0;
+    body.v_world_mm_s = {100.0f * static_cast<float>(seq), -50.0f, 25.0f};
+    body.w_world_rad_s = {0.125f, 0.25f * static_cast<float>(seq), -0.5f};
   }
   f.point_count = 4;
   for (int i = 0; i < 4; ++i) {
@@ -100,6 +105,16 @@ TEST(Ros2Mapping, WorldRotationFrameIdAndTopicTokens) {
   p = ros2::published_pose(body, *z90);      // 270 degrees about z = -90
   EXPECT_NEAR(p.q[0], std::sqrt(0.5), 1e-9);
   EXPECT_NEAR(p.q[3], -std::sqrt(0.5), 1e-9);
+  // Velocities turn with the frame: 90 degrees about z takes x to y.
+  ResultBody moving;
+  moving.v_world_mm_s = {1000.0f, 0.0f, 500.0f};
+  moving.w_world_rad_s = {0.0f, 2.0f, 0.0f};
+  const ros2::TwistOut v = ros2::published_twist(moving, *z90);
+  EXPECT_NEAR(v.v_m_s[0], 0.0, 1e-3);
+  EXPECT_NEAR(v.v_m_s[1], 1.0, 1e-3);
+  EXPECT_NEAR(v.v_m_s[2], 0.5, 1e-9);
+  EXPECT_NEAR(v.w_rad_s[0], -2.0, 1e-3);
+  EXPECT_EQ(ros2::published_twist(moving, ros2::WorldRotation{}).v_m_s[2], 0.5);
   // The identity leaves the values exactly as they are.
   p = ros2::published_pose(body, ros2::WorldRotation{});
   EXPECT_EQ(p.t_m[0], 1000.0 * 1e-3);
@@ -269,6 +284,26 @@ TEST(Ros2Output, PosesEqualTfAndTheCloudHoldsTheUnlabelledPoints) {
     if (!pose_loans[b].empty())
       dds_return_loan(reader.poses_[b], pose_loans[b].data(),
                       static_cast<int32_t>(pose_loans[b].size()));
+  // /mocap/<body>/twist: the torso's velocities from its second frame, in m/s and rad/s,
+  // stamped as its pose; nothing for bodies whose velocities are not known.
+  std::vector<void*> tw_loans;
+  const auto twists =
+      take_all<geometry_msgs_msg_dds__TwistStamped_>(reader.twists_[0], tw_loans);
+  ASSERT_EQ(twists.size(), sent.size() - 1);
+  for (std::size_t k = 0; k < twists.size(); ++k) {
+    const FrameResult& f = sent[k + 1];
+    EXPECT_STREQ(twists[k]->header.frame_id, "mocap");
+    EXPECT_DOUBLE_EQ(twists[k]->twist.linear.x, metres(f.bodies[0].v_world_mm_s[0]));
+    EXPECT_DOUBLE_EQ(twists[k]->twist.linear.y, -0.05);
+    EXPECT_DOUBLE_EQ(twists[k]->twist.angular.y,
+                     static_cast<double>(f.bodies[0].w_world_rad_s[1]));
+    EXPECT_DOUBLE_EQ(twists[k]->twist.angular.z, -0.5);
+  }
+  if (!tw_loans.empty())
+    dds_return_loan(reader.twists_[0], tw_loans.data(), static_cast<int32_t>(tw_loans.size()));
+  std::vector<void*> none_loans;
+  EXPECT_TRUE(
+      take_all<geometry_msgs_msg_dds__TwistStamped_>(reader.twists_[1], none_loans).empty());
 }
 
 TEST(Ros2Output, FrameIdAndWorldRotationTurnTfPosesAndCloudNotJoints) {

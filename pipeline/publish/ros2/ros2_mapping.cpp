@@ -164,6 +164,23 @@ PoseOut published_pose(const ResultBody& body, const WorldRotation& r) noexcept 
   return p;
 }
 
+TwistOut published_twist(const ResultBody& body, const WorldRotation& r) noexcept {
+  TwistOut out;
+  const auto& R = r.R_frame_world;
+  for (std::size_t i = 0; i < 3; ++i) {
+    const auto& v = body.v_world_mm_s;
+    const auto& w = body.w_world_rad_s;
+    const auto turned = [&](const std::array<float, 3>& x) {
+      if (r.identity) return static_cast<double>(x[i]);
+      return R[3 * i] * static_cast<double>(x[0]) + R[3 * i + 1] * static_cast<double>(x[1]) +
+             R[3 * i + 2] * static_cast<double>(x[2]);
+    };
+    out.v_m_s[i] = turned(v) * 1e-3;
+    out.w_rad_s[i] = turned(w);
+  }
+  return out;
+}
+
 std::uint32_t pack_unlabelled(const FrameResult& frame, const WorldRotation& r,
                               std::uint8_t* data) noexcept {
   std::uint32_t n = 0;

@@ -80,6 +80,14 @@ struct PoseOut {
 };
 PoseOut published_pose(const ResultBody& body, const WorldRotation& r) noexcept;
 
+// A body's velocities as published on /mocap/<body>/twist: the origin's linear velocity
+// (m/s) and the angular velocity (rad/s), both in the published frame (turned by `r`).
+struct TwistOut {
+  std::array<double, 3> v_m_s{};
+  std::array<double, 3> w_rad_s{};
+};
+TwistOut published_twist(const ResultBody& body, const WorldRotation& r) noexcept;
+
 // PointCloud2 layout of mocap's unlabelled points: x, y, z float32 at offsets 0, 4, 8.
 inline constexpr std::uint32_t kCloudPointStep = 12;
 inline constexpr std::uint8_t kPointFieldFloat32 = 7;  // sensor_msgs/PointField FLOAT32

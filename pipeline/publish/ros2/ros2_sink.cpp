@@ -12,6 +12,9 @@
 //   rt/mocap/<body>/pose geometry_msgs::msg::dds_::PoseStamped_  per body found, one
 //                    writer per body made at setup (name as a ROS topic token,
 //                    ros2_mapping.h), frame "mocap", metres: the same pose as /tf;
+//   rt/mocap/<body>/twist geometry_msgs::msg::dds_::TwistStamped_  per body found whose
+//                    velocities are known (kinematics/body_rates.h): the origin's
+//                    linear (m/s) and the angular (rad/s) velocity in the same frame;
 //   rt/mocap/unlabeled_markers sensor_msgs::msg::dds_::PointCloud2_  every frame: the
 //                    3D points no body claimed, x y z float32 in metres (height 1);
 //   rt/robot_description std_msgs::msg::dds_::String_     the URDF of the joint model,
@@ -22,7 +25,7 @@
 // ROS_DOMAIN_ID (default 0), or the request option domain_id (outputs.ros2.domain_id).
 // Options frame_id (replaces "mocap" as the parent frame of /tf, the poses and the
 // cloud) and world_rotation (a fixed rotation from mocap's world to that frame, applied
-// to /tf, the poses and the cloud alike; joint angles are relative and stay as they are).
+// to /tf, the poses, the twists and the cloud alike; joint angles are relative and stay as they are).
 // header.stamp: the frame's capture time (CLOCK_MONOTONIC) + the CLOCK_REALTIME offset
 // measured at start. The message buffers are built once; encode() only fills them (the
 // DDS sequences point into them: no allocation of ours per frame).
@@ -94,6 +97,14 @@ class Ros2Sink final : public QueuedSink {
                            settings_.pose_topics[b].c_str(), nullptr, nullptr);
       poses_.push_back(writer(t, qos));
       failed = poses_.back();
+      if (failed < 0) break;
+      // "rt/mocap/<token>/pose" -> ".../twist": the same body's velocities.
+      const std::string& pose = settings_.pose_topics[b];
+      const std::string twist = pose.substr(0, pose.size() - 4) + "twist";
+      const dds_entity_t tw = dds_create_topic(
+          participant_, &geometry_msgs_msg_dds__TwistStamped__desc, twist.c_str(), nullptr, nullptr);
+      twists_.push_back(writer(tw, qos));
+      failed = twists_.back();
     }
     dds_delete_qos(qos);
     if (failed < 0)
@@ -165,6 +176,15 @@ class Ros2Sink final : public QueuedSink {
       ps.pose.orientation = ts.transform.rotation;
       if (const dds_return_t rc = dds_write(poses_[static_cast<std::size_t>(b)], &ps); rc < 0)
         throw std::runtime_error(dds_strretcode(rc));
+      // /mocap/<body>/twist: when the body's velocities are known.
+      if (body.velocity_valid == 0) continue;
+      const ros2::TwistOut v = ros2::published_twist(body, settings_.rotation);
+      geometry_msgs_msg_dds__TwistStamped_ tw{};
+      tw.header = ts.header;
+      tw.twist.linear = {v.v_m_s[0], v.v_m_s[1], v.v_m_s[2]};
+      tw.twist.angular = {v.w_rad_s[0], v.w_rad_s[1], v.w_rad_s[2]};
+      if (const dds_return_t rc = dds_write(twists_[static_cast<std::size_t>(b)], &tw); rc < 0)
+        throw std::runtime_error(dds_strretcode(rc));
     }
     if (t > 0) {
       tf2_msgs_msg_dds__TFMessage_ tf{};
@@ -235,7 +255,8 @@ class Ros2Sink final : public QueuedSink {
 
   Ros2Settings settings_;
   dds_entity_t participant_ = 0, joint_states_ = 0, tf_ = 0, cloud_ = 0, description_ = 0;
-  std::vector<dds_entity_t> poses_;  // per body, targets.yaml order
+  std::vector<dds_entity_t> poses_;   // per body, targets.yaml order
+  std::vector<dds_entity_t> twists_;  // per body, targets.yaml order
   const std::vector<std::string>& bodies_ = settings_.bodies;
   std::array<sensor_msgs_msg_dds__PointField_, 3> cloud_fields_{};
   std::vector<std::uint8_t> cloud_data_;
