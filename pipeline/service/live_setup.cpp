@@ -160,6 +160,14 @@ hal::CameraConfig camera_config(const config::CameraSettings& s, hal::CameraConf
   return base;
 }
 
+// A replay rig with a software-triggered camera: its external-triggered replay cameras
+// follow that master's triggers (a rig of external cameras only free-runs, as before).
+bool replay_has_master(const config::RunConfig& cfg) {
+  for (const config::CameraSettings& c : cfg.cameras)
+    if (c.trigger && *c.trigger == hal::TriggerMode::kSoftware) return true;
+  return false;
+}
+
 void say(std::FILE* log, const std::string& line, const char* command = "mocap run") {
   if (log != nullptr) std::fprintf(log, "%s: %s\n", command, line.c_str());
 }
@@ -252,8 +260,19 @@ Expected<std::unique_ptr<LiveSetup>> LiveSetup::create(const config::RunConfig& 
         pipeline::resolve_stage(s->options_.stages, pipeline::StageId::detect(static_cast<int>(c)),
                                 1)
             .ring_depth;
-    const hal::CameraConfig want =
+    hal::CameraConfig want =
         camera_config(cfg.cameras[c], native[c], assets->rig.cameras[c], depth);
+    if (backend == CameraBackend::kReplay && want.trigger == hal::TriggerMode::kExternal &&
+        replay_has_master(cfg)) {
+      // A lab wires the slave's trigger input to the master's strobe: each master trigger
+      // exposes the slave too. In a replay that wire is the tracker's own trigger.
+      want.trigger = hal::TriggerMode::kSoftware;
+      say(log,
+          cams[c]->name() +
+              ": trigger: external in a replay follows the software-triggered cameras' "
+              "triggers (the master's pulse), frame for frame",
+          command);
+    }
     if (auto r = cams[c]->configure(want); !r) return r.error();
     if (c == 0 && cfg.faults.stall_after_frames > 0) {
       say(log,

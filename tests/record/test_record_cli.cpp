@@ -1,5 +1,6 @@
 // End-to-end tests of `mocap record` on the built-in simulated cameras and on a lockstep
-// replay: bad input, a recording `mocap track` reads, byte-identical re-recording, a
+// replay (also a master with an external-triggered slave): bad input, a recording `mocap
+// track` reads, byte-identical re-recording, a
 // file-size limit (the full-disk path with a real EFBIG), an unwritable folder and a
 // stop signal mid-recording. Each run uses a 10-frame sim loop to stay fast.
 #include <gtest/gtest.h>
@@ -133,35 +134,38 @@ TEST_F(RecordCli, SimRecordingIsReadByTrackAndItsBodiesAreFound) {
   EXPECT_TRUE(fs::exists(out.file("angles.csv")));
 }
 
-TEST_F(RecordCli, LockstepReplayIsRecordedAgainByteIdentical) {
-  make_source();
-  ASSERT_TRUE(source_ok_) << source_log_;
+// Records the source through two replay cameras with the given triggers and pacing and
+// checks the copy: every frame of the source, image for image, byte-identical.
+void expect_replay_recorded_whole(const std::string& source, const std::string& trigger1,
+                                  const std::string& pacing) {
   TempDir dir("rec_replay");
   const std::string cfg = dir.file("replay.yaml");
   write_file(cfg,
              "cameras:\n"
              "  - {backend: replay, device: " +
-                 source() +
+                 source +
                  ", trigger: software}\n"
                  "  - {backend: replay, device: " +
-                 source() +
-                 ", trigger: software}\n"
+                 source + ", trigger: " + trigger1 +
+                 "}\n"
                  "targets: " +
-                 source() +
+                 source +
                  "/targets.yaml\n"
                  "model: " +
-                 source() +
+                 source +
                  "/model.yaml\n"
-                 "pipeline: {pacing: lockstep, realtime: false, lock_memory: false}\n"
+                 "pipeline: {pacing: " +
+                 pacing +
+                 ", realtime: false, lock_memory: false}\n"
                  "outputs: {udp: [], iceoryx: false}\n");
   const std::string copy = dir.file("copy");
   const RunResult r =
       run_mocap("record --config " + cfg + " --out " + copy + " --progress-interval 0", 120);
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_EQ(read_file(copy + "/frames.csv"), read_file(source() + "/frames.csv"));
+  EXPECT_EQ(read_file(copy + "/frames.csv"), read_file(source + "/frames.csv"));
   int files = 0;
   for (const char* cam : {"cam0", "cam1"}) {
-    for (const auto& f : fs::directory_iterator(source() + "/" + cam)) {
+    for (const auto& f : fs::directory_iterator(source + "/" + cam)) {
       const std::string name = f.path().filename().string();
       ASSERT_TRUE(fs::exists(copy + "/" + cam + "/" + name)) << name;
       EXPECT_TRUE(read_file(f.path().string()) == read_file(copy + "/" + cam + "/" + name))
@@ -170,14 +174,40 @@ TEST_F(RecordCli, LockstepReplayIsRecordedAgainByteIdentical) {
     }
     EXPECT_EQ(
         std::distance(fs::directory_iterator(copy + "/" + cam), fs::directory_iterator()),
-        std::distance(fs::directory_iterator(source() + "/" + cam), fs::directory_iterator()));
+        std::distance(fs::directory_iterator(source + "/" + cam), fs::directory_iterator()));
   }
   EXPECT_GE(files, 50);
   EXPECT_NE(r.output.find("30 frames (60 images"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("dropped images: cam0 0, cam1 0"), std::string::npos) << r.output;
   // The configuration's files are copied byte for byte.
-  EXPECT_EQ(read_file(copy + "/model.yaml"), read_file(source() + "/model.yaml"));
-  EXPECT_EQ(read_file(copy + "/targets.yaml"), read_file(source() + "/targets.yaml"));
+  EXPECT_EQ(read_file(copy + "/model.yaml"), read_file(source + "/model.yaml"));
+  EXPECT_EQ(read_file(copy + "/targets.yaml"), read_file(source + "/targets.yaml"));
+  if (trigger1 == "external") {
+    EXPECT_NE(r.output.find("cam1: trigger: external in a replay follows"), std::string::npos)
+        << r.output;
+  }
+}
+
+TEST_F(RecordCli, LockstepReplayIsRecordedAgainByteIdentical) {
+  make_source();
+  ASSERT_TRUE(source_ok_) << source_log_;
+  expect_replay_recorded_whole(source(), "software", "lockstep");
+}
+
+// A master (software trigger) and an external-triggered slave, as a lab wires them: the
+// slave follows the master's triggers, in lockstep and at the trigger rate alike (until
+// 2026-12-07 the slave free-ran and the master recorded a frame a second, silently).
+TEST_F(RecordCli, MasterAndExternalSlaveReplayIsRecordedFrameForFrame) {
+  make_source();
+  ASSERT_TRUE(source_ok_) << source_log_;
+  {
+    SCOPED_TRACE("lockstep");
+    expect_replay_recorded_whole(source(), "external", "lockstep");
+  }
+  {
+    SCOPED_TRACE("periodic");
+    expect_replay_recorded_whole(source(), "external", "periodic");
+  }
 }
 
 // Runs mocap with stdout+stderr into `log`; optional RLIMIT_FSIZE (SIGXFSZ ignored, so a
