@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <thread>
 
+#include "core/listen_address.h"
 #include "pipeline/foxglove/session.h"
 
 namespace mocap::foxglove {
@@ -23,26 +24,10 @@ using tcp = asio::ip::tcp;
 
 Expected<void> parse_listen_address(const std::string& text, const std::string& key,
                                     ServerOptions& options) {
-  std::string address = options.address;
-  std::string port_text = text;
-  const auto colon = text.rfind(':');
-  if (colon != std::string::npos) {
-    address = text.substr(0, colon);
-    port_text = text.substr(colon + 1);
-    if (address.size() > 2 && address.front() == '[' && address.back() == ']') {
-      address = address.substr(1, address.size() - 2);  // [::1]
-    }
-  }
-  if (port_text.empty() || port_text.size() > 5 ||
-      port_text.find_first_not_of("0123456789") != std::string::npos ||
-      std::stoul(port_text) > 65535) {
-    return make_error(key, "'" + text + "'", "expected [ADDRESS:]PORT with PORT 0..65535");
-  }
-  boost::system::error_code ec;
-  asio::ip::make_address(address, ec);
-  if (ec) return make_error(key, "'" + text + "'", "'" + address + "' is not an IP address");
-  options.address = address;
-  options.port = static_cast<std::uint16_t>(std::stoul(port_text));
+  auto a = mocap::parse_listen_address(text, key, options.address, IpFamilies::kIpv4AndIpv6);
+  if (!a) return a.error();
+  options.address = a->address;
+  options.port = a->port;
   return {};
 }
 

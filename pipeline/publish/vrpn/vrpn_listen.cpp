@@ -9,26 +9,16 @@
 #include <cerrno>
 #include <cstring>
 
+#include "core/listen_address.h"
+
 namespace mocap::publish::vrpn {
 
 Expected<void> parse_listen_address(const std::string& text, const std::string& key,
                                     ServerOptions& options) {
-  std::string address = options.address;
-  std::string port_text = text;
-  const auto colon = text.rfind(':');
-  if (colon != std::string::npos) {
-    address = text.substr(0, colon);
-    port_text = text.substr(colon + 1);
-  }
-  if (port_text.empty() || port_text.size() > 5 ||
-      port_text.find_first_not_of("0123456789") != std::string::npos ||
-      std::stoul(port_text) > 65535)
-    return make_error(key, "'" + text + "'", "expected [ADDRESS:]PORT with PORT 0..65535");
-  in_addr a{};
-  if (::inet_pton(AF_INET, address.c_str(), &a) != 1)
-    return make_error(key, "'" + text + "'", "'" + address + "' is not an IPv4 address");
-  options.address = address;
-  options.port = static_cast<std::uint16_t>(std::stoul(port_text));
+  auto a = mocap::parse_listen_address(text, key, options.address, IpFamilies::kIpv4);
+  if (!a) return a.error();
+  options.address = a->address;
+  options.port = a->port;
   return {};
 }
 
