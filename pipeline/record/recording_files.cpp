@@ -25,13 +25,15 @@ Error io_error(const std::string& path, const char* what, int err) {
 Expected<RecordingFiles> RecordingFiles::open(const std::string& dir,
                                               const std::vector<std::string>& camera_names,
                                               std::size_t max_image_bytes,
-                                              std::uint64_t byte_budget) {
+                                              std::uint64_t byte_budget,
+                                              bool camera_folders) {
   RecordingFiles f;
   f.dir_ = dir;
   f.cameras_ = camera_names;
   f.byte_budget_ = byte_budget;
   f.scratch_.resize(max_image_bytes + 64);
   for (const std::string& cam : camera_names) {
+    if (!camera_folders) break;
     const std::string sub = dir + "/" + cam;
     if (::mkdir(sub.c_str(), 0755) != 0 && errno != EEXIST)
       return io_error(sub, "cannot create the camera folder", errno);

@@ -26,10 +26,12 @@ namespace mocap::record {
 class RecordingFiles {
  public:
   // Opens DIR/frames.csv (must not exist; writes the header) and creates one folder per
-  // camera. `max_image_bytes`: the largest image (sizes the 16-bit scratch buffer).
+  // camera (camera_folders false: none, a blob recording that keeps no images).
+  // `max_image_bytes`: the largest image (sizes the 16-bit scratch buffer).
   static Expected<RecordingFiles> open(const std::string& dir,
                                        const std::vector<std::string>& camera_names,
-                                       std::size_t max_image_bytes, std::uint64_t byte_budget = 0);
+                                       std::size_t max_image_bytes, std::uint64_t byte_budget = 0,
+                                       bool camera_folders = true);
   RecordingFiles(RecordingFiles&& other) noexcept;
   RecordingFiles& operator=(RecordingFiles&&) = delete;
   RecordingFiles(const RecordingFiles&) = delete;
