@@ -82,7 +82,7 @@ struct PipelineOptions {
   std::int64_t pair_tolerance_us = 1000;
   FrameObserver* observer = nullptr;
   StageHooks* hooks = nullptr;
-  FrameTap* tap = nullptr;  // `mocap record`: every delivered frame, capture thread
+  FrameTap* tap = nullptr;      // `mocap record`: every delivered frame, capture thread
   BlobTap* blob_tap = nullptr;  // `mocap record --blobs`: every detected frame, detect threads
   // true (`mocap record --blobs`): each detect stage detects every frame in order instead
   // of the newest (no detect#_skipped; a detector that falls behind fills its input ring

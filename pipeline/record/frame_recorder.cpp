@@ -38,8 +38,8 @@ Expected<std::unique_ptr<FrameRecorder>> FrameRecorder::create(const RecorderOpt
     return make_error("mocap record", "detection.max_blobs",
                       "must be 1.." + std::to_string(kMaxBlobFileBlobs) + " for --blobs");
   const bool keep = o.blobs && o.keep_images_every > 0;
-  auto files = RecordingFiles::open(o.dir, o.camera_names, max_bytes,
-                                    o.blobs ? 0 : o.byte_budget, !o.blobs || keep);
+  auto files = RecordingFiles::open(o.dir, o.camera_names, max_bytes, o.blobs ? 0 : o.byte_budget,
+                                    !o.blobs || keep);
   if (!files) return files.error();
   std::unique_ptr<FrameRecorder> r(new FrameRecorder(o, std::move(files).value()));
   if (o.blobs) {
@@ -113,9 +113,9 @@ void FrameRecorder::start() {
 }
 
 bool FrameRecorder::number_of(std::size_t c, std::uint64_t sequence, std::uint64_t base,
-                              std::uint64_t& number) noexcept {
+                              std::uint64_t& number, bool count) noexcept {
   if (sequence < base) {  // older than the first frame: cannot be numbered
-    dropped_[c].add();
+    if (count) dropped_[c].add();
     return false;
   }
   number = sequence - base;
@@ -147,7 +147,8 @@ void FrameRecorder::on_frame(int camera, const hal::Frame& frame) noexcept {
     base_plus_one_.store(frame.sequence + 1, std::memory_order_release);
   }
   std::uint64_t number = 0;
-  if (!number_of(c, frame.sequence, base_sequence_, number)) return;
+  // (blobs: the detect thread, the counter's single writer, counts the drop)
+  if (!number_of(c, frame.sequence, base_sequence_, number, !options_.blobs)) return;
   // relaxed: a progress figure; a single writer (this thread).
   if (number + 1 > seen_.load(std::memory_order_relaxed))
     seen_.store(number + 1, std::memory_order_relaxed);
@@ -184,7 +185,7 @@ void FrameRecorder::on_blobs(int camera, const hal::Frame& frame, bool present,
   // acquire: pairs with on_frame's release store (see there).
   const std::uint64_t base1 = base_plus_one_.load(std::memory_order_acquire);
   std::uint64_t number = 0;
-  if (base1 == 0 || !number_of(c, frame.sequence, base1 - 1, number)) return;
+  if (base1 == 0 || !number_of(c, frame.sequence, base1 - 1, number, true)) return;
   std::uint32_t index = 0;
   if (!take_slot(c, index)) return;
   Slot& s = slots_[c][index];
@@ -203,15 +204,16 @@ void FrameRecorder::on_blobs(int camera, const hal::Frame& frame, bool present,
     const auto row_bytes =
         static_cast<std::size_t>(in.width) * static_cast<std::size_t>(bytes_per_pixel(in.format));
     if (!kept_free_[c]->try_pop(k)) {
-      kept_skipped_.add();
+      kept_skipped_[c].add();
     } else if (row_bytes * static_cast<std::size_t>(in.height) > kept_[c][k].size()) {
-      kept_skipped_.add();
+      kept_skipped_[c].add();
       (void)kept_free_[c]->try_push(k);
     } else {
       std::uint8_t* px = kept_[c][k].data();
       for (int y = 0; y < in.height; ++y)
         std::memcpy(px + static_cast<std::size_t>(y) * row_bytes, in.row8(y), row_bytes);
-      s.view = ImageView{px, in.width, in.height, static_cast<int>(row_bytes), in.format, in.maxval};
+      s.view =
+          ImageView{px, in.width, in.height, static_cast<int>(row_bytes), in.format, in.maxval};
       s.kept = static_cast<std::int32_t>(k);
     }
   }
@@ -380,7 +382,8 @@ RecorderCounts FrameRecorder::counts() const noexcept {
     k.dropped.push_back(dropped_[static_cast<std::size_t>(c)].get());
   k.not_written = not_written_.get();
   k.blob_lists_written = blob_lists_written_.get();
-  k.kept_skipped = kept_skipped_.get();
+  for (int c = 0; c < camera_count(); ++c)
+    k.kept_skipped += kept_skipped_[static_cast<std::size_t>(c)].get();
   return k;
 }
 

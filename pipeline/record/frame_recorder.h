@@ -62,19 +62,21 @@ struct RecorderOptions {
   int wait_for_slot_ms = 0;               // > 0 only in lockstep pacing
   pipeline::PairBy pair_by = pipeline::PairBy::kSequence;
   std::int64_t pair_tolerance_ns = 1'000'000;
-  std::uint64_t byte_budget = 0;  // test hook: ENOSPC past this many bytes (0: off; blobs: per file)
-  bool blobs = false;                   // blob lists (on_blobs) instead of images (on_frame)
+  std::uint64_t byte_budget =
+      0;               // test hook: ENOSPC past this many bytes (0: off; blobs: per file)
+  bool blobs = false;  // blob lists (on_blobs) instead of images (on_frame)
   std::uint32_t max_blobs = 512;        // blobs: the detector's capacity per frame
   std::uint32_t keep_images_every = 0;  // blobs: also every Nth frame's images as PGM (0: none)
-  std::int64_t sync_interval_ns = 1'000'000'000;  // blobs: fdatasync of each file at most this often
+  std::int64_t sync_interval_ns =
+      1'000'000'000;  // blobs: fdatasync of each file at most this often
 };
 
 struct RecorderCounts {
   std::uint64_t frames_written = 0;  // rows of frames.csv
   std::uint64_t images_written = 0;  // PGM files
   std::uint64_t bytes_written = 0;
-  std::vector<std::uint64_t> dropped;  // per camera: images dropped at the tap (no free slot)
-  std::uint64_t not_written = 0;       // frames queued when writing failed or out of order
+  std::vector<std::uint64_t> dropped;    // per camera: images dropped at the tap (no free slot)
+  std::uint64_t not_written = 0;         // frames queued when writing failed or out of order
   std::uint64_t blob_lists_written = 0;  // blobs: chunks of the blob files
   std::uint64_t kept_skipped = 0;        // blobs: images to keep for which no buffer was free
 };
@@ -129,8 +131,9 @@ class FrameRecorder final : public pipeline::FrameTap, public pipeline::BlobTap 
   // Takes a free slot of `camera` (lockstep: waits for one); false: dropped (counted).
   bool take_slot(std::size_t camera, std::uint32_t& index) noexcept;
   // The frame's number from its sequence (false: before the first frame or past max_frames).
+  // `count`: a frame before the first is counted as dropped (by the counter's writer).
   bool number_of(std::size_t camera, std::uint64_t sequence, std::uint64_t base,
-                 std::uint64_t& number) noexcept;
+                 std::uint64_t& number, bool count) noexcept;
   Expected<void> write_blobs(int camera, std::int64_t number, const Slot& s);
 
   RecorderOptions options_;
@@ -144,18 +147,18 @@ class FrameRecorder final : public pipeline::FrameTap, public pipeline::BlobTap 
   std::array<std::vector<std::vector<std::uint8_t>>, kMaxCameras> kept_;
   std::array<std::unique_ptr<rt::SpscRing<std::uint32_t>>, kMaxCameras> kept_free_;
   std::atomic<std::uint64_t> base_plus_one_{0};  // blobs: capture thread -> detect threads
-  std::optional<hal::FramePairer> pairer_;  // writer thread
-  std::vector<Unit> units_;                 // writer thread, reserved
-  std::int64_t last_frame_ = -1;            // writer thread: tap numbering
-  std::int64_t first_frame_ = -1;           // writer thread: the tap's number of frame 0
-  std::optional<Error> error_;              // writer thread until joined
+  std::optional<hal::FramePairer> pairer_;       // writer thread
+  std::vector<Unit> units_;                      // writer thread, reserved
+  std::int64_t last_frame_ = -1;                 // writer thread: tap numbering
+  std::int64_t first_frame_ = -1;                // writer thread: the tap's number of frame 0
+  std::optional<Error> error_;                   // writer thread until joined
 
   // Capture thread.
   bool have_base_ = false;
   std::uint64_t base_sequence_ = 0;
 
   rt::Counter dropped_[kMaxCameras], frames_written_, images_written_, bytes_written_, not_written_;
-  rt::Counter blob_lists_written_, kept_skipped_;
+  rt::Counter blob_lists_written_, kept_skipped_[kMaxCameras];  // kept_skipped_: detect threads
   std::atomic<std::uint64_t> seen_{0};
   std::atomic<bool> failed_{false};
   std::atomic<bool> stop_{false};

@@ -25,8 +25,7 @@ Error io_error(const std::string& path, const char* what, int err) {
 Expected<RecordingFiles> RecordingFiles::open(const std::string& dir,
                                               const std::vector<std::string>& camera_names,
                                               std::size_t max_image_bytes,
-                                              std::uint64_t byte_budget,
-                                              bool camera_folders) {
+                                              std::uint64_t byte_budget, bool camera_folders) {
   RecordingFiles f;
   f.dir_ = dir;
   f.cameras_ = camera_names;

@@ -225,8 +225,10 @@ int record(const RecordArgs& a) {
         per_camera.c_str(), static_cast<unsigned long long>(not_detected),
         static_cast<unsigned long long>(camera_drops));
     if (k.kept_skipped > 0)
-      std::fprintf(stderr, "mocap record: warning: %llu images to keep were skipped (writer "
-                   "behind)\n", static_cast<unsigned long long>(k.kept_skipped));
+      std::fprintf(stderr,
+                   "mocap record: warning: %llu images to keep were skipped (writer "
+                   "behind)\n",
+                   static_cast<unsigned long long>(k.kept_skipped));
   } else {
     std::printf(
         "mocap record: dropped images: %s (writer behind); "

@@ -1,4 +1,4 @@
-// Design: see blob_file.h. Byte layout (all little-endian; docs/formats.md, "Blob files"):
+// Design: see blob_file.h. Byte layout (all little-endian; docs/formats.md, "Blob recordings"):
 //   header  0 magic "MOCAPBLB" | 8 u16 version | 10 u16 header_bytes (= 36 + n) |
 //           12 u16 record_bytes | 14 u16 n (camera name bytes, 1..255) | 16 u32 width |
 //           20 u32 height | 24 u32 max_blobs | 28 u32 reserved (0) | 32 name |
@@ -21,66 +21,11 @@
 #include <cerrno>
 #include <cstring>
 
-#include "client/crc32.h"
-#include "core/clock.h"
+#include "formats/blob_file_codec.h"
 
 namespace mocap {
-namespace {
 
-constexpr char kMagic[8] = {'M', 'O', 'C', 'A', 'P', 'B', 'L', 'B'};
-constexpr std::uint8_t kSync[4] = {'B', 'L', 'B', 'F'};
-constexpr std::size_t kFixedHeaderBytes = 32;
-constexpr std::size_t kMaxRecordBytes = 4096;
-
-void put16(std::uint8_t* p, std::uint16_t v) noexcept {
-  p[0] = static_cast<std::uint8_t>(v);
-  p[1] = static_cast<std::uint8_t>(v >> 8);
-}
-void put32(std::uint8_t* p, std::uint32_t v) noexcept {
-  for (int i = 0; i < 4; ++i) p[i] = static_cast<std::uint8_t>(v >> (8 * i));
-}
-void put64(std::uint8_t* p, std::uint64_t v) noexcept {
-  for (int i = 0; i < 8; ++i) p[i] = static_cast<std::uint8_t>(v >> (8 * i));
-}
-std::uint16_t get16(const std::uint8_t* p) noexcept {
-  return static_cast<std::uint16_t>(p[0] | (p[1] << 8));
-}
-std::uint32_t get32(const std::uint8_t* p) noexcept {
-  std::uint32_t v = 0;
-  for (int i = 3; i >= 0; --i) v = (v << 8) | p[i];
-  return v;
-}
-std::uint64_t get64(const std::uint8_t* p) noexcept {
-  std::uint64_t v = 0;
-  for (int i = 7; i >= 0; --i) v = (v << 8) | p[i];
-  return v;
-}
-void putf(std::uint8_t* p, float v) noexcept { put32(p, std::bit_cast<std::uint32_t>(v)); }
-void putd(std::uint8_t* p, double v) noexcept { put64(p, std::bit_cast<std::uint64_t>(v)); }
-float getf(const std::uint8_t* p) noexcept { return std::bit_cast<float>(get32(p)); }
-double getd(const std::uint8_t* p) noexcept { return std::bit_cast<double>(get64(p)); }
-std::uint16_t box16(int v) noexcept { return static_cast<std::uint16_t>(std::clamp(v, 0, 65535)); }
-
-std::uint32_t crc(const std::uint8_t* p, std::size_t n) noexcept {
-  return client::crc32_ieee(p, n);
-}
-
-// pread all of n bytes at off; false on a short read or an error.
-bool read_at(int fd, std::uint8_t* out, std::size_t n, std::uint64_t off) noexcept {
-  while (n > 0) {
-    const ssize_t r = ::pread(fd, out, n, static_cast<off_t>(off));
-    if (r < 0 && errno == EINTR) continue;
-    if (r <= 0) return false;
-    out += r;
-    n -= static_cast<std::size_t>(r);
-    off += static_cast<std::uint64_t>(r);
-  }
-  return true;
-}
-
-std::string offset_text(std::uint64_t off) { return "byte offset " + std::to_string(off); }
-
-}  // namespace
+using namespace blob_codec;
 
 void encode_blob_record(const detect::Blob& b, std::uint8_t* p) noexcept {
   putd(p + 0, b.x_px);
@@ -122,145 +67,6 @@ detect::Blob decode_blob_record(const std::uint8_t* p) noexcept {
   return b;
 }
 
-// ---- writer ----
-
-Expected<BlobFileWriter> BlobFileWriter::create(const std::string& path, const BlobFileInfo& info,
-                                                std::int64_t sync_interval_ns,
-                                                std::uint64_t byte_budget) {
-  if (info.camera.empty() || info.camera.size() > 255)
-    return make_error(path, "camera", "name must have 1..255 bytes");
-  if (info.width < 1 || info.width > 65535 || info.height < 1 || info.height > 65535)
-    return make_error(path, "", "image size must be 1..65535 pixels each way");
-  if (info.max_blobs < 1 || info.max_blobs > kMaxBlobFileBlobs)
-    return make_error(path, "max_blobs", "must be 1.." + std::to_string(kMaxBlobFileBlobs));
-  BlobFileWriter w;
-  w.path_ = path;
-  w.max_blobs_ = info.max_blobs;
-  w.sync_interval_ns_ = sync_interval_ns;
-  w.byte_budget_ = byte_budget;
-  w.chunk_.assign(kBlobChunkHeaderBytes + info.max_blobs * kBlobRecordBytes + 4, 0);
-  w.fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
-  if (w.fd_ < 0) return make_error(path, "", std::string("cannot create: ") + std::strerror(errno));
-  const std::size_t n = info.camera.size();
-  std::vector<std::uint8_t> h(kFixedHeaderBytes + n + 4, 0);
-  std::memcpy(h.data(), kMagic, 8);
-  put16(&h[8], kBlobFileVersion);
-  put16(&h[10], static_cast<std::uint16_t>(h.size()));
-  put16(&h[12], static_cast<std::uint16_t>(kBlobRecordBytes));
-  put16(&h[14], static_cast<std::uint16_t>(n));
-  put32(&h[16], static_cast<std::uint32_t>(info.width));
-  put32(&h[20], static_cast<std::uint32_t>(info.height));
-  put32(&h[24], info.max_blobs);
-  std::memcpy(&h[kFixedHeaderBytes], info.camera.data(), n);
-  put32(&h[kFixedHeaderBytes + n], crc(h.data(), kFixedHeaderBytes + n));
-  if (!w.write_all(h.data(), h.size()))
-    return make_error(path, "", std::string("cannot write the header: ") + std::strerror(errno));
-  w.length_ = h.size();
-  w.last_sync_ns_ = monotonic_ns();
-  return w;
-}
-
-BlobFileWriter::BlobFileWriter(BlobFileWriter&& o) noexcept { *this = std::move(o); }
-
-BlobFileWriter& BlobFileWriter::operator=(BlobFileWriter&& o) noexcept {
-  if (this == &o) return *this;
-  if (fd_ >= 0) ::close(fd_);
-  path_ = std::move(o.path_);
-  fd_ = o.fd_;
-  o.fd_ = -1;
-  max_blobs_ = o.max_blobs_;
-  length_ = o.length_;
-  last_frame_ = o.last_frame_;
-  sync_interval_ns_ = o.sync_interval_ns_;
-  last_sync_ns_ = o.last_sync_ns_;
-  byte_budget_ = o.byte_budget_;
-  chunk_ = std::move(o.chunk_);
-  return *this;
-}
-
-BlobFileWriter::~BlobFileWriter() {
-  if (fd_ >= 0) ::close(fd_);
-}
-
-bool BlobFileWriter::write_all(const std::uint8_t* data, std::size_t n) noexcept {
-  std::uint64_t off = length_;
-  while (n > 0) {
-    std::size_t step = n;
-    if (byte_budget_ != 0) {
-      if (off >= byte_budget_) {
-        errno = ENOSPC;
-        return false;
-      }
-      step = std::min<std::uint64_t>(step, byte_budget_ - off);
-    }
-    const ssize_t r = ::pwrite(fd_, data, step, static_cast<off_t>(off));
-    if (r < 0 && errno == EINTR) continue;
-    if (r <= 0) {
-      if (r == 0) errno = ENOSPC;
-      return false;
-    }
-    data += r;
-    n -= static_cast<std::size_t>(r);
-    off += static_cast<std::uint64_t>(r);
-  }
-  return true;
-}
-
-Expected<void> BlobFileWriter::append(std::int64_t frame, std::int64_t timestamp_ns,
-                                      const detect::BlobList& blobs) {
-  if (fd_ < 0) return make_error(path_, "", "closed");
-  if (frame <= last_frame_)
-    return make_error(path_, "", "frame " + std::to_string(frame) + " does not follow frame " +
-                                     std::to_string(last_frame_));
-  const std::size_t count = blobs.size();
-  if (count > max_blobs_)
-    return make_error(path_, "", std::to_string(count) + " blobs, the file holds at most " +
-                                     std::to_string(max_blobs_) + " per frame");
-  std::uint8_t* p = chunk_.data();
-  std::memcpy(p, kSync, 4);
-  put32(p + 4, static_cast<std::uint32_t>(count));
-  put64(p + 8, static_cast<std::uint64_t>(frame));
-  put64(p + 16, static_cast<std::uint64_t>(timestamp_ns));
-  putd(p + 24, blobs.levels().background_dn);
-  putd(p + 32, blobs.levels().noise_dn);
-  putd(p + 40, blobs.levels().threshold_dn);
-  for (std::size_t i = 0; i < count; ++i)
-    encode_blob_record(blobs[i], p + kBlobChunkHeaderBytes + i * kBlobRecordBytes);
-  const std::size_t body = kBlobChunkHeaderBytes + count * kBlobRecordBytes;
-  put32(p + body, crc(p, body));
-  if (!write_all(p, body + 4)) {
-    const int e = errno;
-    // The file ends on its last whole chunk again (what a reader would skip anyway).
-    if (::ftruncate(fd_, static_cast<off_t>(length_)) != 0) {
-    }
-    return make_error(path_, "", "cannot write frame " + std::to_string(frame) + ": " +
-                                     std::strerror(e));
-  }
-  length_ += body + 4;
-  last_frame_ = frame;
-  if (sync_interval_ns_ >= 0) {
-    const std::int64_t now = monotonic_ns();
-    if (now - last_sync_ns_ >= sync_interval_ns_) {
-      last_sync_ns_ = now;
-      if (::fdatasync(fd_) != 0)
-        return make_error(path_, "", std::string("fdatasync failed: ") + std::strerror(errno));
-    }
-  }
-  return {};
-}
-
-Expected<void> BlobFileWriter::close() {
-  if (fd_ < 0) return {};
-  const bool synced = ::fdatasync(fd_) == 0;
-  const int e = errno;
-  ::close(fd_);
-  fd_ = -1;
-  if (!synced) return make_error(path_, "", std::string("fdatasync failed: ") + std::strerror(e));
-  return {};
-}
-
-// ---- reader ----
-
 namespace {
 
 // Whether a whole, CRC-valid chunk starts at `off`; fills `c`. `buf` is reused.
@@ -291,7 +97,8 @@ std::uint64_t next_chunk(int fd, std::uint64_t size, std::uint64_t from, const B
   std::vector<std::uint8_t> block(1 << 16);
   BlobFileReader::Chunk c;
   while (from + 4 <= size) {
-    const std::size_t n = static_cast<std::size_t>(std::min<std::uint64_t>(block.size(), size - from));
+    const std::size_t n =
+        static_cast<std::size_t>(std::min<std::uint64_t>(block.size(), size - from));
     if (!read_at(fd, block.data(), n, from)) return size;
     for (std::size_t i = 0; i + 4 <= n; ++i) {
       if (std::memcmp(&block[i], kSync, 4) == 0 && chunk_at(fd, size, from + i, info, buf, c))
@@ -323,20 +130,21 @@ Expected<BlobFileReader> BlobFileReader::open(const std::string& path,
   BlobFileInfo& info = r.info_;
   info.version = get16(h + 8);
   if (info.version != kBlobFileVersion)
-    return make_error(path, "", "blob file version " + std::to_string(info.version) +
-                                    ", this mocap reads version " +
-                                    std::to_string(kBlobFileVersion));
+    return make_error(path, "",
+                      "blob file version " + std::to_string(info.version) +
+                          ", this mocap reads version " + std::to_string(kBlobFileVersion));
   const std::uint16_t header_bytes = get16(h + 10);
   info.record_bytes = get16(h + 12);
   const std::uint16_t n = get16(h + 14);
   if (n < 1 || n > 255 || header_bytes != kFixedHeaderBytes + n + 4 || header_bytes > size)
-    return make_error(path, "header", "inconsistent sizes (camera name " + std::to_string(n) +
-                                          " bytes, header " + std::to_string(header_bytes) +
-                                          " bytes)");
+    return make_error(path, "header",
+                      "inconsistent sizes (camera name " + std::to_string(n) + " bytes, header " +
+                          std::to_string(header_bytes) + " bytes)");
   if (info.record_bytes < kBlobRecordBytes || info.record_bytes > kMaxRecordBytes)
-    return make_error(path, "header", "blob record of " + std::to_string(info.record_bytes) +
-                                          " bytes, expected " + std::to_string(kBlobRecordBytes) +
-                                          ".." + std::to_string(kMaxRecordBytes));
+    return make_error(path, "header",
+                      "blob record of " + std::to_string(info.record_bytes) + " bytes, expected " +
+                          std::to_string(kBlobRecordBytes) + ".." +
+                          std::to_string(kMaxRecordBytes));
   std::vector<std::uint8_t> hdr(header_bytes);
   if (!read_at(r.fd_, hdr.data(), hdr.size(), 0))
     return make_error(path, "", "cannot read the header");
@@ -346,8 +154,9 @@ Expected<BlobFileReader> BlobFileReader::open(const std::string& path,
   info.height = static_cast<int>(std::min<std::uint32_t>(get32(h + 20), 1u << 30));
   info.max_blobs = get32(h + 24);
   if (info.max_blobs < 1 || info.max_blobs > kMaxBlobFileBlobs)
-    return make_error(path, "header", "blob capacity " + std::to_string(info.max_blobs) +
-                                          " outside 1.." + std::to_string(kMaxBlobFileBlobs));
+    return make_error(path, "header",
+                      "blob capacity " + std::to_string(info.max_blobs) + " outside 1.." +
+                          std::to_string(kMaxBlobFileBlobs));
   info.camera.assign(reinterpret_cast<const char*>(&hdr[kFixedHeaderBytes]), n);
   r.data_start_ = header_bytes;
 
@@ -376,7 +185,8 @@ Expected<BlobFileReader> BlobFileReader::open(const std::string& path,
       break;
     }
     warnings.push_back(path + ": damaged bytes at " + offset_text(off) + ".." +
-                       std::to_string(next) + " (no whole chunk with a valid CRC) skipped; the "
+                       std::to_string(next) +
+                       " (no whole chunk with a valid CRC) skipped; the "
                        "frames in them read as dropped");
     r.damaged_bytes_ += next - off;
     ++r.damaged_regions_;
@@ -410,18 +220,18 @@ const BlobFileReader::Chunk* BlobFileReader::find(std::int64_t frame) const noex
 Expected<void> BlobFileReader::load(const Chunk& chunk, detect::BlobList& out,
                                     std::vector<std::uint8_t>& scratch) const {
   out.clear();
-  const std::size_t len =
-      kBlobChunkHeaderBytes + std::size_t{chunk.count} * info_.record_bytes + 4;
+  const std::size_t len = kBlobChunkHeaderBytes + std::size_t{chunk.count} * info_.record_bytes + 4;
   if (scratch.size() < len) scratch.resize(len);
   const std::uint8_t* p = scratch.data();
   if (!read_at(fd_, scratch.data(), len, chunk.offset) || std::memcmp(p, kSync, 4) != 0 ||
       get32(p + 4) != chunk.count || get32(p + len - 4) != crc(p, len - 4))
-    return make_error(path_, "", "chunk of frame " + std::to_string(chunk.frame) + " at " +
-                                     offset_text(chunk.offset) +
-                                     " changed since the recording was opened");
+    return make_error(path_, "",
+                      "chunk of frame " + std::to_string(chunk.frame) + " at " +
+                          offset_text(chunk.offset) + " changed since the recording was opened");
   out.set_levels({getd(p + 24), getd(p + 32), getd(p + 40)});
   for (std::uint32_t i = 0; i < chunk.count; ++i)
-    out.push_back(decode_blob_record(p + kBlobChunkHeaderBytes + i * std::size_t{info_.record_bytes}));
+    out.push_back(
+        decode_blob_record(p + kBlobChunkHeaderBytes + i * std::size_t{info_.record_bytes}));
   return {};
 }
 

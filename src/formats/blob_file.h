@@ -1,5 +1,5 @@
 // Design: the blob file of a blob recording, `blobs/<camera>.blobs` (docs/formats.md,
-// "Blob files"): the detector's blob list of one camera per frame, in place of images.
+// "Blob recordings"): the detector's blob list of one camera per frame, in place of images.
 // Binary, little-endian, versioned, CRC-protected, append-only:
 //   file header  magic "MOCAPBLB", version, header and record sizes, camera name, image
 //                size, the writer's blob capacity, CRC-32 of the header;
@@ -34,8 +34,8 @@
 namespace mocap {
 
 inline constexpr std::uint16_t kBlobFileVersion = 1;
-inline constexpr std::size_t kBlobRecordBytes = 60;       // version 1's record
-inline constexpr std::size_t kBlobChunkHeaderBytes = 48;  // sync .. threshold_dn
+inline constexpr std::size_t kBlobRecordBytes = 60;           // version 1's record
+inline constexpr std::size_t kBlobChunkHeaderBytes = 48;      // sync .. threshold_dn
 inline constexpr std::uint32_t kMaxBlobFileBlobs = 1u << 20;  // = detection.max_blobs' bound
 
 struct BlobFileInfo {

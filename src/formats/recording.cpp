@@ -87,14 +87,15 @@ Expected<Recording> Recording::open(const std::string& dir) {
     for (const CameraModel& cam : rec.rig_.cameras) {
       const std::string path = blob_file_path(dir, cam.name);
       if (::stat(path.c_str(), &st) != 0)
-        return make_error(path, "", "missing blob file of camera '" + cam.name +
-                                        "' named in rig.yaml (the recording has blobs/)");
+        return make_error(path, "",
+                          "missing blob file of camera '" + cam.name +
+                              "' named in rig.yaml (the recording has blobs/)");
       auto reader = BlobFileReader::open(path, rec.warnings_);
       if (!reader) return reader.error();
       const BlobFileInfo& info = reader->info();
       if (info.camera != cam.name)
-        return make_error(path, "header", "camera '" + info.camera + "', expected '" + cam.name +
-                                              "' (rig.yaml)");
+        return make_error(path, "header",
+                          "camera '" + info.camera + "', expected '" + cam.name + "' (rig.yaml)");
       if (info.width != cam.width || info.height != cam.height)
         return make_error(path, "header",
                           "image size " + std::to_string(info.width) + "x" +
@@ -129,9 +130,9 @@ Expected<FrameLoad> Recording::load_blobs(int camera_index, std::int64_t frame,
                                           std::vector<std::uint8_t>& scratch) const {
   if (camera_index < 0 || static_cast<std::size_t>(camera_index) >= blob_files_.size())
     return make_error(dir_, "",
-                      blob_files_.empty() ? "not a blob recording (no blobs/ folder)"
-                                          : "camera index " + std::to_string(camera_index) +
-                                                " out of range");
+                      blob_files_.empty()
+                          ? "not a blob recording (no blobs/ folder)"
+                          : "camera index " + std::to_string(camera_index) + " out of range");
   const BlobFileReader& file = *blob_files_[static_cast<std::size_t>(camera_index)];
   const BlobFileReader::Chunk* chunk = file.find(frame);
   if (chunk == nullptr) {

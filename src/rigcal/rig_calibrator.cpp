@@ -83,9 +83,10 @@ Expected<DetectedRecording> detect_recording(const std::string& dir, const RigCa
   DetectedRecording out;
   out.notes = rec->warnings();
   if (from_blobs && opt.edge_centres)
-    out.notes.push_back(dir + ": a blob recording: the balls' centres are the recorded blob "
-                              "centroids (no edge fits without images; partly hidden balls "
-                              "left out)");
+    out.notes.push_back(dir +
+                        ": a blob recording: the balls' centres are the recorded blob "
+                        "centroids (no edge fits without images; partly hidden balls "
+                        "left out)");
   out.blobs.assign(rec->frames().size(), std::vector<std::vector<Vec2>>(C));
   out.info.assign(rec->frames().size(), std::vector<std::vector<CentreInfo>>(C));
   std::vector<const detect::Blob*> kept;

@@ -113,7 +113,7 @@ struct DetectedRecording {
   FrameCentreInfo info;  // per centre: the edge fit's covariance, partly hidden or not
   RodCutChoice rod_cut;  // whole end balls; end_ball_views = 0 without a wand or edge centres
   RodCutChoice rod_cut_partly_hidden;  // the partly hidden end balls
-  std::vector<std::string> notes;       // one line each (blob recordings: see below)
+  std::vector<std::string> notes;      // one line each (blob recordings: see below)
 };
 
 // A blob recording (formats/recording.h) is read, not detected: its blob lists as the

@@ -58,9 +58,9 @@ void expect_same_bits(const detect::Blob& a, const detect::Blob& b) {
   EXPECT_EQ(a.y_min, b.y_min);
   EXPECT_EQ(a.x_max, b.x_max);
   EXPECT_EQ(a.y_max, b.y_max);
-  for (auto m : {&detect::Blob::major_axis_px, &detect::Blob::minor_axis_px,
-                 &detect::Blob::roundness, &detect::Blob::eccentricity,
-                 &detect::Blob::orientation_rad})
+  for (auto m :
+       {&detect::Blob::major_axis_px, &detect::Blob::minor_axis_px, &detect::Blob::roundness,
+        &detect::Blob::eccentricity, &detect::Blob::orientation_rad})
     EXPECT_EQ(std::bit_cast<std::uint32_t>(a.*m), std::bit_cast<std::uint32_t>(b.*m));
   EXPECT_EQ(a.flags, b.flags);
 }
@@ -184,8 +184,8 @@ TEST(BlobFile, TruncationAtEveryOffsetKeepsEveryWholeFrame) {
     } else {
       ASSERT_EQ(warnings.size(), 1u) << len;
       const std::size_t tail = whole > 0 ? ends[whole - 1] : header;
-      EXPECT_THAT(warnings[0], StartsWith(cut + ": torn tail at byte offset " +
-                                          std::to_string(tail) + " ("));
+      EXPECT_THAT(warnings[0],
+                  StartsWith(cut + ": torn tail at byte offset " + std::to_string(tail) + " ("));
       EXPECT_EQ(r->torn_bytes(), len - tail);
     }
   }
@@ -204,7 +204,8 @@ TEST(BlobFile, DamagedChunkInTheMiddleIsSkippedAndReported) {
     second = r->chunks()[1].offset;
     third = r->chunks()[2].offset;
   }
-  for (std::uint64_t at : {second, second + 5, second + 20, third - 1}) {  // sync, count, frame, CRC
+  for (std::uint64_t at :
+       {second, second + 5, second + 20, third - 1}) {  // sync, count, frame, CRC
     std::string bytes = test::read_file(path);
     bytes[at] = static_cast<char>(bytes[at] ^ 0x5a);
     const std::string bad = dir.file("bad.blobs");

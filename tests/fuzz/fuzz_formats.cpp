@@ -1,10 +1,10 @@
 // Design: fuzz entry points of the file formats: the PGM reader, every YAML/CSV loader
-// of a recording and the blob file reader. The bytes become an in-memory file (fuzz_file) read through
-// the public, path-based API, exactly as `mocap track` reads a recording. A loader must
+// of a recording and the blob file reader. The bytes become an in-memory file (fuzz_file) read
+// through the public, path-based API, exactly as `mocap track` reads a recording. A loader must
 // return a value or a one-line Error; accepted values are checked against the
 // validation the loader promises (finite numbers, sizes in range, one-line messages).
-#include <cmath>
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <string>
 #include <vector>

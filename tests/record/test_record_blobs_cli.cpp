@@ -43,8 +43,9 @@ class RecordBlobsCli : public ::testing::Test {
     std::string cams;
     for (int c = 0; c < 2; ++c)
       cams += "  - {backend: replay, device: " + source() + ", trigger: software}\n";
-    write_file(cfg, "cameras:\n" + cams + "targets: " + source() + "/targets.yaml\nmodel: " +
-                        source() + "/model.yaml\n"
+    write_file(cfg, "cameras:\n" + cams + "targets: " + source() +
+                        "/targets.yaml\nmodel: " + source() +
+                        "/model.yaml\n"
                         "pipeline: {pacing: lockstep, realtime: false, lock_memory: false}\n"
                         "outputs: {udp: [], iceoryx: false}\n");
     return cfg;
@@ -84,8 +85,8 @@ TEST_F(RecordBlobsCli, BlobRecordingOfALockstepReplayTracksToTheSamePoses) {
     }
   }
   // The same poses, points and labelled markers as from the images.
-  const std::string targets = " --targets " + source() + "/targets.yaml --model " + source() +
-                              "/model.yaml";
+  const std::string targets =
+      " --targets " + source() + "/targets.yaml --model " + source() + "/model.yaml";
   const RunResult ti = run_mocap("track " + source() + targets + " --out " + dir.file("ti"), 120);
   ASSERT_EQ(ti.exit_code, 0) << ti.output;
   const RunResult tb = run_mocap("track " + blobs + targets + " --out " + dir.file("tb"), 120);
@@ -99,7 +100,8 @@ TEST_F(RecordBlobsCli, BlobRecordingOfALockstepReplayTracksToTheSamePoses) {
   const std::string joints = source() + "/joints.yaml";
   if (fs::exists(joints)) {
     const std::string c = " --targets " + source() + "/targets.yaml --joints " + joints;
-    const RunResult ci = run_mocap("calibrate " + source() + c + " --out " + dir.file("mi.yaml"), 120);
+    const RunResult ci =
+        run_mocap("calibrate " + source() + c + " --out " + dir.file("mi.yaml"), 120);
     const RunResult cb = run_mocap("calibrate " + blobs + c + " --out " + dir.file("mb.yaml"), 120);
     EXPECT_EQ(ci.exit_code, cb.exit_code) << ci.output << cb.output;
     EXPECT_TRUE(read_file(dir.file("mi.yaml")) == read_file(dir.file("mb.yaml")));
@@ -167,7 +169,8 @@ TEST_F(RecordBlobsCli, FullDiskEndsWithOneLineAndTheFramesBeforeStayReadable) {
   detect::BlobList list(512);
   std::vector<std::uint8_t> scratch;
   for (const FrameEntry& f : rec->frames())  // every frame listed has its blob lists
-    for (int c = 0; c < 2; ++c) EXPECT_EQ(*rec->load_blobs(c, f.frame, list, scratch), FrameLoad::kOk);
+    for (int c = 0; c < 2; ++c)
+      EXPECT_EQ(*rec->load_blobs(c, f.frame, list, scratch), FrameLoad::kOk);
 }
 
 }  // namespace
