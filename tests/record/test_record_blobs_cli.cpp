@@ -106,6 +106,12 @@ TEST_F(RecordBlobsCli, BlobRecordingOfALockstepReplayTracksToTheSamePoses) {
     EXPECT_EQ(ci.exit_code, cb.exit_code) << ci.output << cb.output;
     EXPECT_TRUE(read_file(dir.file("mi.yaml")) == read_file(dir.file("mb.yaml")));
   }
+  // discover finds the same bodies in both.
+  const RunResult di = run_mocap("discover " + source() + " --out " + dir.file("di"), 120);
+  const RunResult db = run_mocap("discover " + blobs + " --out " + dir.file("db"), 120);
+  EXPECT_EQ(di.exit_code, db.exit_code) << di.output << db.output;
+  EXPECT_GT(line_count(read_file(dir.file("di/targets.yaml"))), 5);
+  EXPECT_TRUE(read_file(dir.file("di/targets.yaml")) == read_file(dir.file("db/targets.yaml")));
   // A replay camera cannot play a blob recording: one line.
   const std::string bad_cfg = dir.file("replay_blobs.yaml");
   write_file(bad_cfg, "cameras:\n  - {backend: replay, device: " + blobs +
@@ -117,6 +123,39 @@ TEST_F(RecordBlobsCli, BlobRecordingOfALockstepReplayTracksToTheSamePoses) {
   EXPECT_EQ(line_count(rb.output), 1) << rb.output;
   EXPECT_NE(rb.output.find("a blob recording holds blob lists, not images"), std::string::npos)
       << rb.output;
+}
+
+// calibrate-rig reads a blob recording of a wand: the recorded centroids, no edge fits
+// (one note line), a rig close to the true one.
+TEST_F(RecordBlobsCli, CalibrateRigReadsAWandBlobRecording) {
+  TempDir dir("recb_wand");
+  const std::string wand = dir.file("wand");
+  const RunResult sim =
+      run_mocap("simulate --out " + wand + " --motion wand --frames 300 --seed 3", 120);
+  ASSERT_EQ(sim.exit_code, 0) << sim.output;
+  const std::string cfg = dir.file("replay_wand.yaml");
+  write_file(cfg, "cameras:\n  - {backend: replay, device: " + wand +
+                      ", trigger: software}\n  - {backend: replay, device: " + wand +
+                      ", trigger: software}\npipeline: {pacing: lockstep, realtime: false, "
+                      "lock_memory: false}\noutputs: {udp: [], iceoryx: false}\n");
+  const std::string blobs = dir.file("wand_blobs");
+  const RunResult rec = run_mocap(
+      "record --blobs --config " + cfg + " --out " + blobs + " --progress-interval 0", 120);
+  ASSERT_EQ(rec.exit_code, 0) << rec.output;
+  EXPECT_NE(rec.output.find("300 frames (600 blob lists"), std::string::npos) << rec.output;
+  const RunResult cal = run_mocap(
+      "calibrate-rig " + blobs + " --wand " + wand + "/wand.yaml --out " + dir.file("rig.yaml"),
+      120);
+  ASSERT_EQ(cal.exit_code, 0) << cal.output;
+  EXPECT_NE(cal.output.find("note: " + blobs +
+                            ": a blob recording: the balls' centres are the "
+                            "recorded blob centroids"),
+            std::string::npos)
+      << cal.output;
+  // The simulated rig's baseline is 477 mm (docs/rig_calibration.md).
+  const std::size_t at = cal.output.find("baseline ");
+  ASSERT_NE(at, std::string::npos) << cal.output;
+  EXPECT_NEAR(std::stod(cal.output.substr(at + 9)), 477.0, 0.5) << cal.output;
 }
 
 TEST_F(RecordBlobsCli, BadFlagsAreOneLineErrors) {
