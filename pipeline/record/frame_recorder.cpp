@@ -43,6 +43,7 @@ Expected<std::unique_ptr<FrameRecorder>> FrameRecorder::create(const RecorderOpt
   if (!files) return files.error();
   std::unique_ptr<FrameRecorder> r(new FrameRecorder(o, std::move(files).value()));
   if (o.blobs) {
+    r->files_.set_sync_interval(o.sync_interval_ns);  // frames.csv as durable as the blobs
     const std::string folder = o.dir + "/blobs";
     if (::mkdir(folder.c_str(), 0755) != 0 && errno != EEXIST)
       return make_error(folder, "", std::string("cannot create: ") + std::strerror(errno));

@@ -10,6 +10,7 @@
 #include <cstring>
 #include <utility>
 
+#include "core/clock.h"
 #include "formats/recording.h"
 
 namespace mocap::record {
@@ -55,6 +56,8 @@ RecordingFiles::RecordingFiles(RecordingFiles&& o) noexcept
       csv_length_(o.csv_length_),
       bytes_written_(o.bytes_written_),
       byte_budget_(o.byte_budget_),
+      sync_interval_ns_(o.sync_interval_ns_),
+      last_sync_ns_(o.last_sync_ns_),
       scratch_(std::move(o.scratch_)) {}
 
 RecordingFiles::~RecordingFiles() {
@@ -151,6 +154,13 @@ Expected<void> RecordingFiles::append_row(std::int64_t frame, std::int64_t times
     return io_error(dir_ + "/frames.csv", "cannot write", err);
   }
   csv_length_ += static_cast<std::uint64_t>(n);
+  if (sync_interval_ns_ >= 0) {  // blob recordings: bounded loss on power failure
+    const std::int64_t now = monotonic_ns();
+    if (now - last_sync_ns_ >= sync_interval_ns_) {
+      last_sync_ns_ = now;
+      (void)::fdatasync(csv_fd_);  // a failure shows again in finish()'s fsync
+    }
+  }
   return {};
 }
 
