@@ -6,7 +6,7 @@
 # crashes go to <build>/fuzz-findings/<name>/. A crash input should be added to
 # tests/fuzz/corpus/<name>/ as a regression seed once fixed (CI replays every seed).
 # Usage: deploy/fuzz.sh [SECONDS_PER_TARGET (default 60)] [TARGET ...]
-#   targets: pgm rig targets joints model frames_csv datagram blob_detector
+#   targets: pgm rig targets joints model frames_csv datagram blob_detector blob_file
 # Environment: MOCAP_FUZZ_BUILD (build folder), MOCAP_FUZZ_JOBS (parallel fuzzing
 # processes per target, default 1), MOCAP_FUZZ_NICE (nice level, default 10).
 set -euo pipefail
@@ -18,7 +18,7 @@ if ! [[ "$seconds" =~ ^[0-9]+$ ]] || [ "$seconds" -lt 1 ]; then
   echo "fuzz.sh: the duration must be a whole number of seconds >= 1, got '$seconds'" >&2
   exit 2
 fi
-all_targets=(pgm rig targets joints model frames_csv datagram blob_detector)
+all_targets=(pgm rig targets joints model frames_csv datagram blob_detector blob_file)
 targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then targets=("${all_targets[@]}"); fi
 for t in "${targets[@]}"; do

@@ -14,6 +14,10 @@ constexpr int kMaxReplayBuffers = 32;
 Expected<std::unique_ptr<ReplayCamera>> ReplayCamera::open(
     std::shared_ptr<const Recording> recording, int camera_index, ReplayPacing pacing) {
   if (!recording) return make_error("replay", "", "no recording");
+  if (recording->has_blobs())  // blobs/<camera>.blobs: nothing to deliver as images
+    return make_error(recording->dir(), "blobs",
+                      "a blob recording holds blob lists, not images: a replay camera needs "
+                      "an image recording (track, calibrate and discover read blob recordings)");
   const int n = static_cast<int>(recording->rig().cameras.size());
   if (camera_index < 0 || camera_index >= n) {
     return make_error(

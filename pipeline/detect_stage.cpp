@@ -43,6 +43,8 @@ void DetectStage::run() noexcept {
   context_.loop_start(id);
   Doorbell& bell = context_.bell(id);
   Doorbell& next = context_.bell(StageId::kIdentify);
+  const bool every_frame = context_.options().detect_every_frame;
+  BlobTap* const tap = context_.options().blob_tap;
   while (!context_.stopping()) {
     const std::uint32_t seen = bell.snapshot();
     hal::Frame f;
@@ -51,8 +53,8 @@ void DetectStage::run() noexcept {
       continue;
     }
     hal::Frame newer;
-    while (input_.try_pop(newer)) {  // drop-oldest: work on the freshest frame
-      returned_.try_push(f);         // cannot fail: holds every camera buffer
+    while (!every_frame && input_.try_pop(newer)) {  // drop-oldest: work on the freshest frame
+      returned_.try_push(f);                         // cannot fail: holds every camera buffer
       counters_.skipped.add();
       f = newer;
     }
@@ -71,6 +73,7 @@ void DetectStage::run() noexcept {
       library_.blobs.add(slot.blobs.size());
       library_.detector.publish(kDetectorFields, processor_.detector_counters(camera_));
     }
+    if (tap != nullptr) tap->on_blobs(camera_, f, slot.present, slot.blobs);
     slot.sequence = f.sequence;
     slot.capture_ns = f.timestamp_ns;
     const std::int64_t origin_ns = hal::latency_origin_ns(f);

@@ -40,6 +40,18 @@ class FrameTap {
   virtual void on_frame(int camera, const hal::Frame& frame) noexcept = 0;
 };
 
+// Called on each camera's detect thread with every frame it detected, right after the
+// detection and before the image goes back to the camera: `mocap record --blobs` copies
+// the blob list (and every Nth image) here (pipeline/record). Must be noexcept,
+// allocation-free and return quickly (lockstep pacing may wait briefly). `present`:
+// false when the camera's frame was missing (blobs then empty).
+class BlobTap {
+ public:
+  virtual ~BlobTap() = default;
+  virtual void on_blobs(int camera, const hal::Frame& frame, bool present,
+                        const detect::BlobList& blobs) noexcept = 0;
+};
+
 // Called on each stage thread right before its loop starts and right after it ends
 // (tests count the thread's heap allocations in between).
 class StageHooks {
@@ -70,7 +82,12 @@ struct PipelineOptions {
   std::int64_t pair_tolerance_us = 1000;
   FrameObserver* observer = nullptr;
   StageHooks* hooks = nullptr;
-  FrameTap* tap = nullptr;  // `mocap record`: every delivered frame, capture thread
+  FrameTap* tap = nullptr;      // `mocap record`: every delivered frame, capture thread
+  BlobTap* blob_tap = nullptr;  // `mocap record --blobs`: every detected frame, detect threads
+  // true (`mocap record --blobs`): each detect stage detects every frame in order instead
+  // of the newest (no detect#_skipped; a detector that falls behind fills its input ring
+  // and the capture drops there, counted as ring_full).
+  bool detect_every_frame = false;
 };
 
 }  // namespace mocap::pipeline

@@ -1,9 +1,14 @@
 // Design: see frame_recorder.h.
 #include "pipeline/record/frame_recorder.h"
 
+#include <sys/stat.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cstring>
+
+#include "formats/recording.h"
 
 namespace mocap::record {
 
@@ -29,9 +34,31 @@ Expected<std::unique_ptr<FrameRecorder>> FrameRecorder::create(const RecorderOpt
         std::max(max_bytes, static_cast<std::size_t>(g.width) * static_cast<std::size_t>(g.height) *
                                 static_cast<std::size_t>(bytes_per_pixel(g.format)));
   }
-  auto files = RecordingFiles::open(o.dir, o.camera_names, max_bytes, o.byte_budget);
+  if (o.blobs && (o.max_blobs < 1 || o.max_blobs > kMaxBlobFileBlobs))
+    return make_error("mocap record", "detection.max_blobs",
+                      "must be 1.." + std::to_string(kMaxBlobFileBlobs) + " for --blobs");
+  const bool keep = o.blobs && o.keep_images_every > 0;
+  auto files = RecordingFiles::open(o.dir, o.camera_names, max_bytes, o.blobs ? 0 : o.byte_budget,
+                                    !o.blobs || keep);
   if (!files) return files.error();
   std::unique_ptr<FrameRecorder> r(new FrameRecorder(o, std::move(files).value()));
+  if (o.blobs) {
+    r->files_.set_sync_interval(o.sync_interval_ns);  // frames.csv as durable as the blobs
+    const std::string folder = o.dir + "/blobs";
+    if (::mkdir(folder.c_str(), 0755) != 0 && errno != EEXIST)
+      return make_error(folder, "", std::string("cannot create: ") + std::strerror(errno));
+    for (std::size_t c = 0; c < static_cast<std::size_t>(n); ++c) {
+      BlobFileInfo info;
+      info.camera = o.camera_names[c];
+      info.width = o.cameras[c].width;
+      info.height = o.cameras[c].height;
+      info.max_blobs = o.max_blobs;
+      auto w = BlobFileWriter::create(Recording::blob_file_path(o.dir, info.camera), info,
+                                      o.sync_interval_ns, o.byte_budget);
+      if (!w) return w.error();
+      r->blob_files_.push_back(std::move(w).value());
+    }
+  }
   hal::PairerConfig pc;
   pc.tolerance = o.pair_by == pipeline::PairBy::kSequence ? 0 : o.pair_tolerance_ns;
   pc.max_pending = o.slots_per_camera;
@@ -45,7 +72,21 @@ Expected<std::unique_ptr<FrameRecorder>> FrameRecorder::create(const RecorderOpt
                               static_cast<std::size_t>(g.height) *
                               static_cast<std::size_t>(bytes_per_pixel(g.format));
     r->slots_[c].resize(o.slots_per_camera);
-    for (Slot& s : r->slots_[c]) s.pixels.assign(bytes, 0);  // touched: no page faults later
+    for (Slot& s : r->slots_[c]) {
+      if (o.blobs)
+        s.blobs.set_capacity(o.max_blobs);
+      else
+        s.pixels.assign(bytes, 0);  // touched: no page faults later
+    }
+    if (keep) {  // enough buffers for the kept images of a full write-behind, and 2 more
+      const std::uint32_t k = static_cast<std::uint32_t>(rt::next_power_of_two_at_least(
+          o.slots_per_camera / std::min(o.keep_images_every, o.slots_per_camera) + 2));
+      r->kept_[c].assign(k, std::vector<std::uint8_t>(bytes, 0));
+      auto ring = rt::SpscRing<std::uint32_t>::create(k);
+      if (!ring) return ring.error();
+      r->kept_free_[c] = std::make_unique<rt::SpscRing<std::uint32_t>>(std::move(ring).value());
+      for (std::uint32_t i = 0; i < k; ++i) (void)r->kept_free_[c]->try_push(i);
+    }
     auto filled = rt::SpscRing<std::uint32_t>::create(o.slots_per_camera);
     auto free = rt::SpscRing<std::uint32_t>::create(o.slots_per_camera);
     if (!filled) return filled.error();
@@ -72,23 +113,17 @@ void FrameRecorder::start() {
   if (!writer_.joinable()) writer_ = std::thread([this] { writer_loop(); });
 }
 
-void FrameRecorder::on_frame(int camera, const hal::Frame& frame) noexcept {
-  if (camera < 0 || camera >= camera_count()) return;  // not a camera of this recording
-  const auto c = static_cast<std::size_t>(camera);
-  if (!have_base_) {
-    have_base_ = true;
-    base_sequence_ = frame.sequence;
+bool FrameRecorder::number_of(std::size_t c, std::uint64_t sequence, std::uint64_t base,
+                              std::uint64_t& number, bool count) noexcept {
+  if (sequence < base) {  // older than the first frame: cannot be numbered
+    if (count) dropped_[c].add();
+    return false;
   }
-  if (frame.sequence < base_sequence_) {  // older than the first frame: cannot be numbered
-    dropped_[c].add();
-    return;
-  }
-  const std::uint64_t number = frame.sequence - base_sequence_;
-  if (options_.max_frames != 0 && number >= options_.max_frames) return;
-  // relaxed: a progress figure; a single writer (this thread).
-  if (number + 1 > seen_.load(std::memory_order_relaxed))
-    seen_.store(number + 1, std::memory_order_relaxed);
-  std::uint32_t index = 0;
+  number = sequence - base;
+  return options_.max_frames == 0 || number < options_.max_frames;
+}
+
+bool FrameRecorder::take_slot(std::size_t c, std::uint32_t& index) noexcept {
   bool got = free_[c]->try_pop(index);
   if (!got && options_.wait_for_slot_ms > 0) {  // lockstep only: wait for the writer
     const std::int64_t deadline =
@@ -98,10 +133,29 @@ void FrameRecorder::on_frame(int camera, const hal::Frame& frame) noexcept {
       got = free_[c]->try_pop(index);
     }
   }
-  if (!got) {  // the writer is behind: drop this image, counted
-    dropped_[c].add();
-    return;
+  if (!got) dropped_[c].add();  // the writer is behind: drop this frame, counted
+  return got;
+}
+
+void FrameRecorder::on_frame(int camera, const hal::Frame& frame) noexcept {
+  if (camera < 0 || camera >= camera_count()) return;  // not a camera of this recording
+  const auto c = static_cast<std::size_t>(camera);
+  if (!have_base_) {
+    have_base_ = true;
+    base_sequence_ = frame.sequence;
+    // release: the detect threads get this frame through the capture's rings after this
+    // store; their acquire load (on_blobs) sees the base.
+    base_plus_one_.store(frame.sequence + 1, std::memory_order_release);
   }
+  std::uint64_t number = 0;
+  // (blobs: the detect thread, the counter's single writer, counts the drop)
+  if (!number_of(c, frame.sequence, base_sequence_, number, !options_.blobs)) return;
+  // relaxed: a progress figure; a single writer (this thread).
+  if (number + 1 > seen_.load(std::memory_order_relaxed))
+    seen_.store(number + 1, std::memory_order_relaxed);
+  if (options_.blobs) return;  // the blob list comes through on_blobs
+  std::uint32_t index = 0;
+  if (!take_slot(c, index)) return;
   Slot& s = slots_[c][index];
   s.sequence = frame.sequence;
   s.frame = static_cast<std::int64_t>(number);
@@ -125,9 +179,65 @@ void FrameRecorder::on_frame(int camera, const hal::Frame& frame) noexcept {
   (void)filled_[c]->try_push(index);  // never full: it has a place for every slot
 }
 
+void FrameRecorder::on_blobs(int camera, const hal::Frame& frame, bool present,
+                             const detect::BlobList& blobs) noexcept {
+  if (!options_.blobs || camera < 0 || camera >= camera_count()) return;
+  const auto c = static_cast<std::size_t>(camera);
+  // acquire: pairs with on_frame's release store (see there).
+  const std::uint64_t base1 = base_plus_one_.load(std::memory_order_acquire);
+  std::uint64_t number = 0;
+  if (base1 == 0 || !number_of(c, frame.sequence, base1 - 1, number, true)) return;
+  std::uint32_t index = 0;
+  if (!take_slot(c, index)) return;
+  Slot& s = slots_[c][index];
+  s.sequence = frame.sequence;
+  s.frame = static_cast<std::int64_t>(number);
+  s.timestamp_ns = frame.timestamp_ns;
+  s.missing = !present;
+  s.blobs.clear();
+  s.blobs.set_levels(blobs.levels());
+  for (const detect::Blob& b : blobs) (void)s.blobs.push_back(b);  // same capacity
+  s.kept = -1;
+  s.view = ImageView{};
+  const ImageView& in = frame.image;
+  std::uint32_t k = 0;
+  if (present && kept_free_[c] && number % options_.keep_images_every == 0) {
+    const auto row_bytes =
+        static_cast<std::size_t>(in.width) * static_cast<std::size_t>(bytes_per_pixel(in.format));
+    if (!kept_free_[c]->try_pop(k)) {
+      kept_skipped_[c].add();
+    } else if (row_bytes * static_cast<std::size_t>(in.height) > kept_[c][k].size()) {
+      kept_skipped_[c].add();
+      (void)kept_free_[c]->try_push(k);
+    } else {
+      std::uint8_t* px = kept_[c][k].data();
+      for (int y = 0; y < in.height; ++y)
+        std::memcpy(px + static_cast<std::size_t>(y) * row_bytes, in.row8(y), row_bytes);
+      s.view =
+          ImageView{px, in.width, in.height, static_cast<int>(row_bytes), in.format, in.maxval};
+      s.kept = static_cast<std::int32_t>(k);
+    }
+  }
+  (void)filled_[c]->try_push(index);  // never full: it has a place for every slot
+}
+
 void FrameRecorder::free_slot(int camera, std::int32_t slot) noexcept {
-  if (slot >= 0)
-    (void)free_[static_cast<std::size_t>(camera)]->try_push(static_cast<std::uint32_t>(slot));
+  if (slot < 0) return;
+  const auto c = static_cast<std::size_t>(camera);
+  Slot& s = slots_[c][static_cast<std::size_t>(slot)];
+  if (s.kept >= 0) (void)kept_free_[c]->try_push(static_cast<std::uint32_t>(s.kept));
+  s.kept = -1;
+  (void)free_[c]->try_push(static_cast<std::uint32_t>(slot));
+}
+
+Expected<void> FrameRecorder::write_blobs(int camera, std::int64_t number, const Slot& s) {
+  auto r = blob_files_[static_cast<std::size_t>(camera)].append(number, s.timestamp_ns, s.blobs);
+  if (!r) return r;
+  blob_lists_written_.add();
+  if (s.kept < 0) return {};
+  r = files_.write_image(camera, number, s.view);
+  if (r) images_written_.add();
+  return r;
 }
 
 bool FrameRecorder::drain(bool flush) {
@@ -174,6 +284,11 @@ void FrameRecorder::write_unit(const Unit& u) {
       if (u.slot[c] < 0) continue;
       const Slot& s = slots_[static_cast<std::size_t>(c)][static_cast<std::size_t>(u.slot[c])];
       if (s.missing) continue;
+      if (options_.blobs) {  // its chunk stays if the row fails: not in frames.csv, never read
+        r = write_blobs(c, number, s);
+        if (r && s.kept >= 0) written[c] = c;
+        continue;
+      }
       r = files_.write_image(c, number, s.view);
       if (r) written[c] = c;
     }
@@ -191,9 +306,12 @@ void FrameRecorder::write_unit(const Unit& u) {
     } else {
       last_frame_ = u.frame;
       frames_written_.add();
-      for (int c : written)
-        if (c >= 0) images_written_.add();
-      bytes_written_.add(files_.bytes_written() - bytes_written_.get());
+      if (!options_.blobs)
+        for (int c : written)
+          if (c >= 0) images_written_.add();
+      std::uint64_t bytes = files_.bytes_written();
+      for (const BlobFileWriter& w : blob_files_) bytes += w.bytes();
+      bytes_written_.add(bytes - bytes_written_.get());
     }
   } else {
     not_written_.add();
@@ -248,6 +366,10 @@ Expected<void> FrameRecorder::finish() {
     write_units();
   }
   auto synced = files_.finish();
+  for (BlobFileWriter& w : blob_files_) {
+    auto closed = w.close();
+    if (synced && !closed) synced = closed;
+  }
   if (error_) return *error_;
   return synced;
 }
@@ -260,6 +382,9 @@ RecorderCounts FrameRecorder::counts() const noexcept {
   for (int c = 0; c < camera_count(); ++c)
     k.dropped.push_back(dropped_[static_cast<std::size_t>(c)].get());
   k.not_written = not_written_.get();
+  k.blob_lists_written = blob_lists_written_.get();
+  for (int c = 0; c < camera_count(); ++c)
+    k.kept_skipped += kept_skipped_[static_cast<std::size_t>(c)].get();
   return k;
 }
 

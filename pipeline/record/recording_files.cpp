@@ -10,6 +10,7 @@
 #include <cstring>
 #include <utility>
 
+#include "core/clock.h"
 #include "formats/recording.h"
 
 namespace mocap::record {
@@ -25,13 +26,14 @@ Error io_error(const std::string& path, const char* what, int err) {
 Expected<RecordingFiles> RecordingFiles::open(const std::string& dir,
                                               const std::vector<std::string>& camera_names,
                                               std::size_t max_image_bytes,
-                                              std::uint64_t byte_budget) {
+                                              std::uint64_t byte_budget, bool camera_folders) {
   RecordingFiles f;
   f.dir_ = dir;
   f.cameras_ = camera_names;
   f.byte_budget_ = byte_budget;
   f.scratch_.resize(max_image_bytes + 64);
   for (const std::string& cam : camera_names) {
+    if (!camera_folders) break;
     const std::string sub = dir + "/" + cam;
     if (::mkdir(sub.c_str(), 0755) != 0 && errno != EEXIST)
       return io_error(sub, "cannot create the camera folder", errno);
@@ -54,6 +56,8 @@ RecordingFiles::RecordingFiles(RecordingFiles&& o) noexcept
       csv_length_(o.csv_length_),
       bytes_written_(o.bytes_written_),
       byte_budget_(o.byte_budget_),
+      sync_interval_ns_(o.sync_interval_ns_),
+      last_sync_ns_(o.last_sync_ns_),
       scratch_(std::move(o.scratch_)) {}
 
 RecordingFiles::~RecordingFiles() {
@@ -150,6 +154,13 @@ Expected<void> RecordingFiles::append_row(std::int64_t frame, std::int64_t times
     return io_error(dir_ + "/frames.csv", "cannot write", err);
   }
   csv_length_ += static_cast<std::uint64_t>(n);
+  if (sync_interval_ns_ >= 0) {  // blob recordings: bounded loss on power failure
+    const std::int64_t now = monotonic_ns();
+    if (now - last_sync_ns_ >= sync_interval_ns_) {
+      last_sync_ns_ = now;
+      (void)::fdatasync(csv_fd_);  // a failure shows again in finish()'s fsync
+    }
+  }
   return {};
 }
 

@@ -7,7 +7,8 @@
 //     row that cannot be written completely is cut off again (ftruncate to the last good
 //     length) and the frame's files are removed, so frames.csv and the files agree;
 //   - finish() fsyncs frames.csv and syncfs()es the folder once (durability at the end,
-//     without one fsync per file).
+//     without one fsync per file); blob recordings also fdatasync frames.csv about once a
+//     second (set_sync_interval), as their blob files are.
 // Writing is done by the recorder's writer thread (not real-time): plain POSIX I/O with
 // one scratch buffer allocated at open. A test hook (byte_budget) turns the writes past
 // a budget into ENOSPC, to test the full-disk path without a full disk.
@@ -26,10 +27,12 @@ namespace mocap::record {
 class RecordingFiles {
  public:
   // Opens DIR/frames.csv (must not exist; writes the header) and creates one folder per
-  // camera. `max_image_bytes`: the largest image (sizes the 16-bit scratch buffer).
+  // camera (camera_folders false: none, a blob recording that keeps no images).
+  // `max_image_bytes`: the largest image (sizes the 16-bit scratch buffer).
   static Expected<RecordingFiles> open(const std::string& dir,
                                        const std::vector<std::string>& camera_names,
-                                       std::size_t max_image_bytes, std::uint64_t byte_budget = 0);
+                                       std::size_t max_image_bytes, std::uint64_t byte_budget = 0,
+                                       bool camera_folders = true);
   RecordingFiles(RecordingFiles&& other) noexcept;
   RecordingFiles& operator=(RecordingFiles&&) = delete;
   RecordingFiles(const RecordingFiles&) = delete;
@@ -40,6 +43,8 @@ class RecordingFiles {
   // Appends "frame,timestamp_ns" (frame after every file of it was written). On failure
   // the partial row is removed again.
   Expected<void> append_row(std::int64_t frame, std::int64_t timestamp_ns);
+  // fdatasync frames.csv after a row at most every `ns` (< 0: only in finish(), the default).
+  void set_sync_interval(std::int64_t ns) noexcept { sync_interval_ns_ = ns; }
   // Removes camera `camera`'s file of `frame` (a frame whose row could not be written).
   void remove_image(int camera, std::int64_t frame) noexcept;
   // fsync(frames.csv), syncfs(folder), close.
@@ -59,6 +64,8 @@ class RecordingFiles {
   std::uint64_t csv_length_ = 0;  // bytes of complete rows
   std::uint64_t bytes_written_ = 0;
   std::uint64_t byte_budget_ = 0;  // 0: unlimited
+  std::int64_t sync_interval_ns_ = -1;
+  std::int64_t last_sync_ns_ = 0;
   std::vector<std::uint8_t> scratch_;
 };
 

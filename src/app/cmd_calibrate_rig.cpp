@@ -164,6 +164,8 @@ int run(const RigArgs& a) {
   }
   auto detected = rigcal::detect_recording(a.recording, opt, &intr, &objects->wand);
   if (!detected) return fail(detected.error().message);
+  for (const std::string& n : detected->notes)
+    std::fprintf(stderr, "mocap calibrate-rig: note: %s\n", n.c_str());
   auto result = rigcal::calibrate_from_blobs(detected->blobs, objects->wand, intr, opt, a.recording,
                                              &detected->info);
   if (!result) return fail(result.error().message);
@@ -172,6 +174,8 @@ int run(const RigArgs& a) {
   if (!a.lframe.empty()) {
     auto lb = rigcal::detect_recording(a.lframe, opt, &intr);
     if (!lb) return fail(lb.error().message);
+    for (const std::string& n : lb->notes)
+      std::fprintf(stderr, "mocap calibrate-rig: note: %s\n", n.c_str());
     if (auto r = rigcal::set_ground_frame(*result, lb->blobs, objects->lframe, opt, a.lframe); !r)
       return fail(r.error().message);
   }

@@ -10,6 +10,9 @@
 // written is always a valid recording. A progress line every --progress-interval seconds;
 // drops are reported at the end. Exit codes: 0 recorded (also when stopped by a signal),
 // 1 writing failed (the recording holds the frames before the failure), 2 bad input.
+// --blobs: the detector's blob lists (the pipeline's detect stages, the configuration's
+// detection settings, every frame in order) in place of images, blobs/<camera>.blobs
+// (formats/blob_file.h); --keep-images N also keeps every Nth frame's images as PGM.
 #include <atomic>
 #include <chrono>
 #include <csignal>
@@ -48,6 +51,9 @@ struct RecordArgs {
   double progress_interval_s = 1.0;
   service::CliOverrides cli;  // --rate, --loop-frames, --no-realtime (app/config_flags.h)
   bool duration_given = false, frames_given = false;
+  bool blobs = false;
+  long long keep_images = 0;
+  bool keep_given = false;
 };
 
 Expected<void> check_args(const RecordArgs& a) {
@@ -59,6 +65,12 @@ Expected<void> check_args(const RecordArgs& a) {
     return make_error("mocap record", "--duration", "must be > 0 seconds");
   if (a.frames_given && a.frames < 1)
     return make_error("mocap record", "--frames", "must be >= 1, got " + std::to_string(a.frames));
+  if (a.keep_given && !a.blobs)
+    return make_error("mocap record", "--keep-images",
+                      "only with --blobs (an image recording keeps every image)");
+  if (a.keep_given && (a.keep_images < 1 || a.keep_images > 1'000'000))
+    return make_error("mocap record", "--keep-images",
+                      "must be 1..1000000 (every Nth frame), got " + std::to_string(a.keep_images));
   if (!(a.progress_interval_s >= 0.0))
     return make_error("mocap record", "--progress-interval", "must be >= 0");
   return {};
@@ -119,9 +131,16 @@ int record(const RecordArgs& a) {
   ro.wait_for_slot_ms = lockstep ? 1000 : 0;  // lockstep records every frame
   ro.pair_by = opt.pair_by;
   ro.pair_tolerance_ns = opt.pair_tolerance_us * 1000;
+  ro.blobs = a.blobs;
+  ro.max_blobs = static_cast<std::uint32_t>(cfg->tracker.detect.max_blobs);
+  ro.keep_images_every = static_cast<std::uint32_t>(a.keep_images);
   auto recorder = record::FrameRecorder::create(ro);
   if (!recorder) return fail(recorder.error().message);
   opt.tap = recorder->get();
+  if (a.blobs) {  // the blob lists of the pipeline's detect stages, every frame in order
+    opt.blob_tap = recorder->get();
+    opt.detect_every_frame = true;
+  }
   opt.max_frames = trigger_limit;
   auto pipe = pipeline::Pipeline::create((*live)->take_processor(), (*live)->cameras(), {}, opt);
   if (!pipe) return fail(pipe.error().message);
@@ -174,19 +193,49 @@ int record(const RecordArgs& a) {
   const record::RecorderCounts k = (*recorder)->counts();
   std::uint64_t camera_drops = 0;
   for (hal::Camera* cam : (*live)->cameras()) camera_drops += cam->counters().dropped.get();
-  std::printf("mocap record: %llu frames (%llu images, %.1f MB) in %.1f s written to %s\n",
-              static_cast<unsigned long long>(k.frames_written),
-              static_cast<unsigned long long>(k.images_written),
-              static_cast<double>(k.bytes_written) / 1e6, elapsed_s, a.out.c_str());
+  if (a.blobs) {
+    std::printf(
+        "mocap record: %llu frames (%llu blob lists, %llu kept images, %.1f MB) in %.1f s "
+        "written to %s\n",
+        static_cast<unsigned long long>(k.frames_written),
+        static_cast<unsigned long long>(k.blob_lists_written),
+        static_cast<unsigned long long>(k.images_written),
+        static_cast<double>(k.bytes_written) / 1e6, elapsed_s, a.out.c_str());
+  } else {
+    std::printf("mocap record: %llu frames (%llu images, %.1f MB) in %.1f s written to %s\n",
+                static_cast<unsigned long long>(k.frames_written),
+                static_cast<unsigned long long>(k.images_written),
+                static_cast<double>(k.bytes_written) / 1e6, elapsed_s, a.out.c_str());
+  }
   std::string per_camera;  // "cam0 N, cam1 N, ..."
   for (std::size_t c = 0; c < k.dropped.size(); ++c)
     per_camera +=
         (c > 0 ? ", cam" : "cam") + std::to_string(c) + " " + std::to_string(k.dropped[c]);
-  std::printf(
-      "mocap record: dropped images: %s (writer behind); "
-      "frames the cameras dropped: %llu\n",
-      per_camera.c_str(), static_cast<unsigned long long>(camera_drops));
-  if (total(k.dropped) > 0) {
+  if (a.blobs) {
+    // Frames that never reached the recorder: the detect stage had no blob slot, or its
+    // input ring was full (detect_every_frame: a detector behind drops at the capture).
+    std::uint64_t not_detected = 0;
+    for (const auto& [name, value] : (*pipe)->stats().counters)
+      if ((name.rfind("detect", 0) == 0 && name.find("_no_slot") != std::string::npos) ||
+          name.rfind("capture_dropped_cam", 0) == 0)
+        not_detected += value;
+    std::printf(
+        "mocap record: dropped blob lists: %s (writer behind); frames the pipeline did not "
+        "detect: %llu; frames the cameras dropped: %llu\n",
+        per_camera.c_str(), static_cast<unsigned long long>(not_detected),
+        static_cast<unsigned long long>(camera_drops));
+    if (k.kept_skipped > 0)
+      std::fprintf(stderr,
+                   "mocap record: warning: %llu images to keep were skipped (writer "
+                   "behind)\n",
+                   static_cast<unsigned long long>(k.kept_skipped));
+  } else {
+    std::printf(
+        "mocap record: dropped images: %s (writer behind); "
+        "frames the cameras dropped: %llu\n",
+        per_camera.c_str(), static_cast<unsigned long long>(camera_drops));
+  }
+  if (!a.blobs && total(k.dropped) > 0) {
     std::fprintf(stderr,
                  "mocap record: warning: %llu images dropped because the disk wrote %.1f MB/s, "
                  "slower than the cameras' %.1f MB/s (their frames have missing files)\n",
@@ -230,8 +279,13 @@ void register_record(CLI::App& app, int& exit_code) {
                   "(power of two, default 64)");
   cmd->add_option("--progress-interval", args->progress_interval_s,
                   "Seconds between progress lines on stderr (default 1; 0: off)");
+  cmd->add_flag("--blobs", args->blobs,
+                "Record the detector's blob lists (blobs/<camera>.blobs) instead of images");
+  cmd->add_option("--keep-images", args->keep_images,
+                  "With --blobs: also keep every Nth frame's images as PGM, for inspection");
   add_no_realtime_flag(*cmd, args->cli);
   cmd->callback([cmd, args, &exit_code] {
+    args->keep_given = cmd->count("--keep-images") > 0;
     args->duration_given = cmd->count("--duration") > 0;
     args->frames_given = cmd->count("--frames") > 0;
     exit_code = record(*args);

@@ -1,13 +1,12 @@
 // Design: see frame_points.h.
 #include "discover/frame_points.h"
 
-#include <array>
 #include <optional>
-#include <span>
 #include <vector>
 
 #include "formats/recording.h"
 #include "track/frame_processor.h"
+#include "track/frame_source.h"
 
 namespace mocap::discover {
 
@@ -29,9 +28,10 @@ Expected<PointSequence> triangulate_recording(const std::string& recording_dir,
   PointSequence seq;
   std::optional<Error> first_error;
   std::size_t usable_frames = 0;
-  std::vector<Image> images(n_cams);
-  std::array<ImageView, kMaxCameras> image_views{};
-  std::array<const ImageView*, kMaxCameras> views{};
+  for (const std::string& w : rec->warnings())  // a blob file's torn tail, damaged chunks
+    if (cb.warn) cb.warn(w);
+  // Detected images or a blob recording's blob lists (track/frame_source.h).
+  FrameSource source(*rec, *proc, 1);
   const auto& frames = rec->frames();
   seq.frames.reserve(frames.size());
   for (std::size_t fi = 0; fi < frames.size(); ++fi) {
@@ -39,27 +39,16 @@ Expected<PointSequence> triangulate_recording(const std::string& recording_dir,
     FramePoints fp;
     fp.frame = fe.frame;
     fp.timestamp_ns = fe.timestamp_ns;
-    std::size_t present = 0;
-    for (std::size_t c = 0; c < n_cams; ++c) {
-      views[c] = nullptr;
-      auto loaded = rec->load_frame(static_cast<int>(c), fe.frame, images[c]);
-      if (!loaded) {  // a damaged frame is skipped (as in `mocap calibrate`), and reported
-        if (!first_error) first_error = loaded.error();
-        if (cb.warn) {
-          cb.warn(loaded.error().message + " (frame " + std::to_string(fe.frame) + ", camera " +
-                  rig.cameras[c].name + " skipped)");
-        }
-        continue;
-      }
-      if (*loaded != FrameLoad::kOk) continue;
-      image_views[c] = images[c].view();
-      views[c] = &image_views[c];
-      ++present;
+    const FrameSource::Result loaded = source.load(fe.frame, out);
+    if (loaded.damaged > 0) {  // a damaged frame is skipped (as in `mocap calibrate`), and reported
+      if (!first_error) first_error = Error{loaded.problem};
+      if (cb.warn) cb.warn(loaded.problem + " (frame " + std::to_string(fe.frame) + " skipped)");
     }
+    const auto present = static_cast<std::size_t>(loaded.present);
     if (present < n_cams) ++seq.frames_missing_camera;
     if (present >= static_cast<std::size_t>(kMinCameras)) {  // two cameras triangulate
       ++usable_frames;
-      proc->process(std::span<const ImageView* const>(views.data(), n_cams), fe.timestamp_ns, out);
+      proc->process_blobs(fe.timestamp_ns, out);
       for (int i = 0; i < out.points.size(); ++i) {
         const Point3& p = out.points[i];
         // Whole-marker views only: with three or more cameras the tracker has already

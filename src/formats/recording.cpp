@@ -2,13 +2,15 @@
 // rig.yaml, frames.csv and the presence of every camera's folder, so that replay only
 // meets per-frame problems. load_frame builds the frame's path in a stack buffer and
 // reads with the allocation-free PGM core: replaying into the same Image allocates
-// nothing per frame.
+// nothing per frame. Blob recordings: see recording.h and blob_file.h.
 #include "formats/recording.h"
 
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <cstdio>
 
+#include "formats/blob_file.h"
 #include "formats/csv_parse.h"
 #include "formats/pgm_read.h"
 #include "formats/rig_yaml.h"
@@ -76,6 +78,33 @@ Expected<Recording> Recording::open(const std::string& dir) {
   auto frames = load_frames_csv(dir + "/frames.csv");
   if (!frames) return frames.error();
   rec.frames_ = std::move(*frames);
+  // A blob recording: the blob file of any rig camera (a camera named "blobs" of an image
+  // recording has PGMs there, no .blobs file).
+  bool blobs = false;
+  for (const CameraModel& cam : rec.rig_.cameras)
+    blobs = blobs || ::stat(blob_file_path(dir, cam.name).c_str(), &st) == 0;
+  if (blobs) {
+    for (const CameraModel& cam : rec.rig_.cameras) {
+      const std::string path = blob_file_path(dir, cam.name);
+      if (::stat(path.c_str(), &st) != 0)
+        return make_error(path, "",
+                          "missing blob file of camera '" + cam.name +
+                              "' named in rig.yaml (the recording has blobs/)");
+      auto reader = BlobFileReader::open(path, rec.warnings_);
+      if (!reader) return reader.error();
+      const BlobFileInfo& info = reader->info();
+      if (info.camera != cam.name)
+        return make_error(path, "header",
+                          "camera '" + info.camera + "', expected '" + cam.name + "' (rig.yaml)");
+      if (info.width != cam.width || info.height != cam.height)
+        return make_error(path, "header",
+                          "image size " + std::to_string(info.width) + "x" +
+                              std::to_string(info.height) + ", rig.yaml says " +
+                              std::to_string(cam.width) + "x" + std::to_string(cam.height));
+      rec.blob_files_.push_back(std::make_shared<const BlobFileReader>(std::move(*reader)));
+    }
+    return rec;
+  }
   for (const CameraModel& cam : rec.rig_.cameras) {
     const std::string folder = dir + "/" + cam.name;
     if (::stat(folder.c_str(), &st) != 0 || !S_ISDIR(st.st_mode)) {
@@ -84,6 +113,34 @@ Expected<Recording> Recording::open(const std::string& dir) {
     }
   }
   return rec;
+}
+
+std::uint32_t Recording::max_blobs() const noexcept {
+  std::uint32_t m = 0;
+  for (const auto& f : blob_files_) m = std::max(m, f->info().max_blobs);
+  return m;
+}
+
+std::string Recording::blob_file_path(const std::string& dir, const std::string& camera) {
+  return dir + "/blobs/" + camera + ".blobs";
+}
+
+Expected<FrameLoad> Recording::load_blobs(int camera_index, std::int64_t frame,
+                                          detect::BlobList& out,
+                                          std::vector<std::uint8_t>& scratch) const {
+  if (camera_index < 0 || static_cast<std::size_t>(camera_index) >= blob_files_.size())
+    return make_error(dir_, "",
+                      blob_files_.empty()
+                          ? "not a blob recording (no blobs/ folder)"
+                          : "camera index " + std::to_string(camera_index) + " out of range");
+  const BlobFileReader& file = *blob_files_[static_cast<std::size_t>(camera_index)];
+  const BlobFileReader::Chunk* chunk = file.find(frame);
+  if (chunk == nullptr) {
+    out.clear();
+    return FrameLoad::kMissing;
+  }
+  if (auto r = file.load(*chunk, out, scratch); !r) return r.error();
+  return FrameLoad::kOk;
 }
 
 Expected<FrameLoad> Recording::load_frame(int camera_index, std::int64_t frame, Image& out) const {

@@ -72,8 +72,21 @@ Expected<DetectedRecording> detect_recording(const std::string& dir, const RigCa
     if (!d) return d.error();
     det.push_back(std::move(*d));
   }
+  // A blob recording (formats/recording.h): its blob lists, as the recorder's detector
+  // found them; the edge fits need the images, so the centres are the centroids and
+  // partly hidden balls are left out (docs/rig_calibration.md, "Blob recordings").
+  const bool from_blobs = rec->has_blobs();
+  const bool edges = opt.edge_centres && !from_blobs;
   detect::BlobList list = det[0].make_blob_list();
+  if (from_blobs && list.capacity() < rec->max_blobs()) list.set_capacity(rec->max_blobs());
+  std::vector<std::uint8_t> scratch;
   DetectedRecording out;
+  out.notes = rec->warnings();
+  if (from_blobs && opt.edge_centres)
+    out.notes.push_back(dir +
+                        ": a blob recording: the balls' centres are the recorded blob "
+                        "centroids (no edge fits without images; partly hidden balls "
+                        "left out)");
   out.blobs.assign(rec->frames().size(), std::vector<std::vector<Vec2>>(C));
   out.info.assign(rec->frames().size(), std::vector<std::vector<CentreInfo>>(C));
   std::vector<const detect::Blob*> kept;
@@ -87,10 +100,16 @@ Expected<DetectedRecording> detect_recording(const std::string& dir, const RigCa
   detect::EdgeSamples samples;
   for (std::size_t f = 0; f < rec->frames().size(); ++f) {
     for (std::size_t c = 0; c < C; ++c) {
-      auto r = rec->load_frame(static_cast<int>(c), rec->frames()[f].frame, img[c]);
-      if (!r) return r.error();
-      if (*r == FrameLoad::kMissing) continue;
-      det[c].detect(img[c].view(), list);
+      if (from_blobs) {
+        auto r = rec->load_blobs(static_cast<int>(c), rec->frames()[f].frame, list, scratch);
+        if (!r) return r.error();
+        if (*r == FrameLoad::kMissing) continue;
+      } else {
+        auto r = rec->load_frame(static_cast<int>(c), rec->frames()[f].frame, img[c]);
+        if (!r) return r.error();
+        if (*r == FrameLoad::kMissing) continue;
+        det[c].detect(img[c].view(), list);
+      }
       const CameraModel& cam = cams ? (*cams)[c] : rec->rig().cameras[c];
       kept.clear();
       round.clear();
@@ -104,7 +123,7 @@ Expected<DetectedRecording> detect_recording(const std::string& dir, const RigCa
               static_cast<double>(b.roundness) < opt.min_roundness * expected_roundness(cam, px));
         // A blob less round than a whole ball is kept only as a wand ball whose edge is
         // fitted (below): its centroid is biased, the fit leaves the hidden rim out.
-        if (!is_round && !(opt.edge_centres && wand)) continue;
+        if (!is_round && !(edges && wand)) continue;
         kept.push_back(&b);
         round.push_back(is_round);
       }
@@ -112,7 +131,7 @@ Expected<DetectedRecording> detect_recording(const std::string& dir, const RigCa
       // WandCentres (the rim along the wand's axis left out on the rod's side).
       Vec2 axis = Vec2::Zero();
       role.assign(kept.size(), -1);
-      if (opt.edge_centres && wand) {
+      if (edges && wand) {
         // Labelled on every kept blob, else (a less round stray or a piece of a ball
         // cut in two on the wand's segment) on the round ones alone.
         auto label = [&](bool round_only) {
@@ -146,7 +165,7 @@ Expected<DetectedRecording> detect_recording(const std::string& dir, const RigCa
         if (!round[i] && role[i] < 0) continue;  // not a wand ball: a stray or a cut piece
         centres.emplace_back(b.x_px, b.y_px);
         info.push_back(CentreInfo{Eigen::Matrix2d::Zero(), !round[i]});
-        if (!opt.edge_centres) continue;
+        if (!edges) continue;
         const Vec2 radial = centres.back() - Vec2(cam.cx, cam.cy);
         const bool sampled =
             detect::sample_edge(img[c].view(), b, list.levels().noise_dn, radial.x(), radial.y(),
@@ -170,7 +189,7 @@ Expected<DetectedRecording> detect_recording(const std::string& dir, const RigCa
       }
     }
   }
-  if (opt.edge_centres && wand) {
+  if (edges && wand) {
     out.rod_cut = wand_centres.choose(opt.rod_cut_deg, false);
     out.rod_cut_partly_hidden = wand_centres.choose(opt.rod_cut_deg, true);
     wand_centres.apply(out.rod_cut, out.blobs, &out.info, &out.rod_cut_partly_hidden);

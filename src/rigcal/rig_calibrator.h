@@ -113,8 +113,13 @@ struct DetectedRecording {
   FrameCentreInfo info;  // per centre: the edge fit's covariance, partly hidden or not
   RodCutChoice rod_cut;  // whole end balls; end_ball_views = 0 without a wand or edge centres
   RodCutChoice rod_cut_partly_hidden;  // the partly hidden end balls
+  std::vector<std::string> notes;      // one line each (blob recordings: see below)
 };
 
+// A blob recording (formats/recording.h) is read, not detected: its blob lists as the
+// recorder's detector found them (its settings, not options.detector), without edge fits
+// (they need the images): the centres are the centroids, partly hidden balls are left
+// out, and a note says so.
 // Detects blobs in every frame of a recording (every camera of its rig.yaml: 2..8, else
 // a one-line error naming the rig.yaml). Blobs that are merged, split or touch the
 // border are left out. A blob less round than options.min_roundness x the roundness a

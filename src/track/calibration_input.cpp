@@ -1,6 +1,7 @@
 #include "track/calibration_input.h"
 
 #include "formats/recording.h"
+#include "track/frame_source.h"
 
 namespace mocap {
 
@@ -14,14 +15,15 @@ Expected<CollectedCalibration> collect_calibration_input(const std::string& reco
 
   CollectedCalibration result;
   FrameOutput out = proc->make_output();
-  FrameSetLoader loader(*rec);
+  for (const std::string& w : rec->warnings())
+    if (opt.warn) opt.warn(w);
+  FrameSource source(*rec, *proc, 1);
   const auto& frames = rec->frames();
   for (std::size_t fi = 0; fi < frames.size(); ++fi) {
     const FrameEntry& fe = frames[fi];
-    const FrameSetLoader::Result loaded = loader.load(fe.frame);
+    const FrameSource::Result loaded = source.process(fe, out);
     if (loaded.damaged > 0 && opt.warn)
       opt.warn(loaded.problem + " (frame " + std::to_string(fe.frame) + " skipped)");
-    proc->process(loader.views(), fe.timestamp_ns, out);
     ++result.frames;
 
     kinematics::CalibrationFrame frame;

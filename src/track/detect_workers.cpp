@@ -42,8 +42,7 @@ void ParallelDetect::run() noexcept {
   }
 }
 
-bool ParallelDetect::process(std::span<const ImageView* const> views, std::int64_t timestamp_ns,
-                             FrameOutput& out) noexcept {
+void ParallelDetect::detect(std::span<const ImageView* const> views, FrameOutput& out) noexcept {
   const std::int64_t t0 = monotonic_ns();
   views_ = views;
   out_ = &out;
@@ -56,6 +55,12 @@ bool ParallelDetect::process(std::span<const ImageView* const> views, std::int64
        d = done_.load(std::memory_order_acquire))
     done_.wait(d, std::memory_order_acquire);
   out.times.detect = monotonic_ns() - t0;
+}
+
+bool ParallelDetect::process(std::span<const ImageView* const> views, std::int64_t timestamp_ns,
+                             FrameOutput& out) noexcept {
+  const std::int64_t t0 = monotonic_ns();
+  detect(views, out);
   const bool ok = proc_.process_blobs(timestamp_ns, out);
   out.times.frame = monotonic_ns() - t0;
   return ok;

@@ -28,6 +28,9 @@ class ParallelDetect {
   ParallelDetect(const ParallelDetect&) = delete;
   ParallelDetect& operator=(const ParallelDetect&) = delete;
 
+  // Stage 1 alone (out.blobs, out.camera_present, out.times.detect), split over the two
+  // threads; the caller then runs FrameProcessor::process_blobs.
+  void detect(std::span<const ImageView* const> views, FrameOutput& out) noexcept;
   // FrameProcessor::process with the detection split over the two threads.
   bool process(std::span<const ImageView* const> views, std::int64_t timestamp_ns,
                FrameOutput& out) noexcept;

@@ -10,7 +10,7 @@
 #include "formats/joints_yaml.h"
 #include "formats/recording.h"
 #include "formats/targets_yaml.h"
-#include "track/detect_workers.h"
+#include "track/frame_source.h"
 #include "track/labelled_markers.h"
 #include "track/trajectory_export.h"
 
@@ -40,6 +40,9 @@ Expected<OfflineTrackResult> track_recording(const OfflineTrackOptions& opt) {
   }
   for (const std::string& w : proc->warnings()) {
     if (opt.warn) opt.warn(opt.targets_path + ": " + w);
+  }
+  for (const std::string& w : rec->warnings()) {  // a blob file's torn tail, damaged chunks
+    if (opt.warn) opt.warn(w);
   }
 
   std::error_code ec;
@@ -74,16 +77,15 @@ Expected<OfflineTrackResult> track_recording(const OfflineTrackOptions& opt) {
   }
 
   FrameOutput out = proc->make_output();
-  // Detection on the two cores, as live (detect_workers.h); one camera needs no worker.
-  std::optional<ParallelDetect> parallel;
-  if (opt.detect_threads >= 2 && proc->camera_count() >= 2) parallel.emplace(*proc);
-  FrameSetLoader loader(*rec);
+  // Detection on the two cores, as live (detect_workers.h), or the blob lists of a blob
+  // recording (frame_source.h).
+  FrameSource source(*rec, *proc, opt.detect_threads);
   PointRow point_row;
   PoseRow pose_row;
   AngleRow angle_row;
   for (std::size_t fi = 0; fi < frames.size(); ++fi) {
     const FrameEntry& fe = frames[fi];
-    const FrameSetLoader::Result loaded = loader.load(fe.frame);
+    const FrameSource::Result loaded = source.process(fe, out);
     const bool missing = loaded.missing > 0;
     const bool damaged = loaded.damaged > 0;
     if (damaged && opt.warn)
@@ -91,11 +93,6 @@ Expected<OfflineTrackResult> track_recording(const OfflineTrackOptions& opt) {
     result.frames_missing += missing ? 1 : 0;
     result.frames_damaged += damaged ? 1 : 0;
 
-    if (parallel) {
-      parallel->process(loader.views(), fe.timestamp_ns, out);
-    } else {
-      proc->process(loader.views(), fe.timestamp_ns, out);
-    }
     result.stats->record(out.times);
     ++result.stats->frames;
     ++result.frames;

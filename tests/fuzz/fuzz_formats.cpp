@@ -1,12 +1,15 @@
-// Design: fuzz entry points of the file formats: the PGM reader and every YAML/CSV
-// loader of a recording. The bytes become an in-memory file (fuzz_file) read through
-// the public, path-based API, exactly as `mocap track` reads a recording. A loader must
+// Design: fuzz entry points of the file formats: the PGM reader, every YAML/CSV loader
+// of a recording and the blob file reader. The bytes become an in-memory file (fuzz_file) read
+// through the public, path-based API, exactly as `mocap track` reads a recording. A loader must
 // return a value or a one-line Error; accepted values are checked against the
 // validation the loader promises (finite numbers, sizes in range, one-line messages).
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <vector>
 
+#include "formats/blob_file.h"
 #include "formats/joints_yaml.h"
 #include "formats/pgm.h"
 #include "formats/recording.h"
@@ -136,6 +139,33 @@ int fuzz_frames_csv(const std::uint8_t* data, std::size_t size) {
       fuzz_check((*r)[i].frame > (*r)[i - 1].frame, "frames not strictly increasing");
     }
     for (const FrameEntry& e : *r) fuzz_check(e.timestamp_ns >= 0, "negative timestamp accepted");
+  }
+  return 0;
+}
+
+int fuzz_blob_file(const std::uint8_t* data, std::size_t size) {
+  const char* path = fuzz_file(data, size);
+  std::vector<std::string> warnings;
+  auto r = BlobFileReader::open(path, warnings);
+  check_error_is_one_line(r);
+  for (const std::string& w : warnings)
+    fuzz_check(!w.empty() && w.find('\n') == std::string::npos, "multi-line warning");
+  if (!r) return 0;
+  fuzz_check(r->info().max_blobs >= 1 && r->info().max_blobs <= kMaxBlobFileBlobs,
+             "blob capacity out of range accepted");
+  fuzz_check(r->info().record_bytes >= kBlobRecordBytes, "short blob record accepted");
+  static detect::BlobList list(64);  // a capacity below the file's: the rest is refused
+  static std::vector<std::uint8_t> scratch;
+  std::uint64_t bytes = 0;
+  for (std::size_t i = 0; i < r->chunks().size(); ++i) {
+    const BlobFileReader::Chunk& c = r->chunks()[i];
+    fuzz_check(c.count <= r->info().max_blobs, "chunk with more blobs than the capacity");
+    fuzz_check(i == 0 || c.frame > r->chunks()[i - 1].frame, "frames not strictly increasing");
+    fuzz_check(r->find(c.frame) == &c, "find() misses an indexed frame");
+    bytes += kBlobChunkHeaderBytes + std::uint64_t{c.count} * r->info().record_bytes + 4;
+    fuzz_check(bytes <= size, "chunks larger than the file");
+    fuzz_check(r->load(c, list, scratch).ok(), "an indexed chunk does not load");
+    fuzz_check(list.size() == std::min<std::size_t>(c.count, 64), "blob count differs");
   }
   return 0;
 }

@@ -21,17 +21,23 @@ int fuzz_frames_csv(const std::uint8_t* data, std::size_t size);     // frames.c
 int fuzz_datagram(const std::uint8_t* data, std::size_t size);       // UDP datagram decoder
 int fuzz_blob_detector(const std::uint8_t* data, std::size_t size);  // detector on any image
 int fuzz_vrpn(const std::uint8_t* data, std::size_t size);           // VRPN client input
+int fuzz_blob_file(const std::uint8_t* data, std::size_t size);      // blob file reader
 
 struct FuzzTarget {
   const char* name;  // also the corpus folder name
   int (*entry)(const std::uint8_t*, std::size_t);
 };
 inline constexpr FuzzTarget kFuzzTargets[] = {
-    {"pgm", fuzz_pgm},           {"rig", fuzz_rig},
-    {"targets", fuzz_targets},   {"joints", fuzz_joints},
-    {"model", fuzz_model},       {"frames_csv", fuzz_frames_csv},
-    {"datagram", fuzz_datagram}, {"blob_detector", fuzz_blob_detector},
+    {"pgm", fuzz_pgm},
+    {"rig", fuzz_rig},
+    {"targets", fuzz_targets},
+    {"joints", fuzz_joints},
+    {"model", fuzz_model},
+    {"frames_csv", fuzz_frames_csv},
+    {"datagram", fuzz_datagram},
+    {"blob_detector", fuzz_blob_detector},
     {"vrpn", fuzz_vrpn},
+    {"blob_file", fuzz_blob_file},
 };
 
 // Aborts with "fuzz invariant failed: <what>" (a finding in both builds).
