@@ -279,6 +279,7 @@ void FrameRecorder::write_unit(const Unit& u) {
     const std::int64_t number = u.frame - first_frame_;
     const int n = camera_count();
     int written[kMaxCameras] = {-1, -1, -1, -1, -1, -1, -1, -1};
+    bool has[kMaxCameras] = {};  // the camera's image (or blob list) is in the recording
     Expected<void> r;
     for (int c = 0; c < n && r; ++c) {
       if (u.slot[c] < 0) continue;
@@ -287,10 +288,12 @@ void FrameRecorder::write_unit(const Unit& u) {
       if (options_.blobs) {  // its chunk stays if the row fails: not in frames.csv, never read
         r = write_blobs(c, number, s);
         if (r && s.kept >= 0) written[c] = c;
+        has[c] = static_cast<bool>(r);
         continue;
       }
       r = files_.write_image(c, number, s.view);
       if (r) written[c] = c;
+      has[c] = static_cast<bool>(r);
     }
     int ts_cam = 0;  // the first camera with an image slot gives the timestamp
     while (ts_cam + 1 < n && u.slot[ts_cam] < 0) ++ts_cam;
@@ -306,6 +309,8 @@ void FrameRecorder::write_unit(const Unit& u) {
     } else {
       last_frame_ = u.frame;
       frames_written_.add();
+      for (int c = 0; c < n; ++c)
+        if (!has[c]) without_image_[static_cast<std::size_t>(c)].add();
       if (!options_.blobs)
         for (int c : written)
           if (c >= 0) images_written_.add();
@@ -382,6 +387,8 @@ RecorderCounts FrameRecorder::counts() const noexcept {
   for (int c = 0; c < camera_count(); ++c)
     k.dropped.push_back(dropped_[static_cast<std::size_t>(c)].get());
   k.not_written = not_written_.get();
+  for (int c = 0; c < camera_count(); ++c)
+    k.without_image.push_back(without_image_[static_cast<std::size_t>(c)].get());
   k.blob_lists_written = blob_lists_written_.get();
   for (int c = 0; c < camera_count(); ++c)
     k.kept_skipped += kept_skipped_[static_cast<std::size_t>(c)].get();

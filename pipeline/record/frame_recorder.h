@@ -75,8 +75,11 @@ struct RecorderCounts {
   std::uint64_t frames_written = 0;  // rows of frames.csv
   std::uint64_t images_written = 0;  // PGM files
   std::uint64_t bytes_written = 0;
-  std::vector<std::uint64_t> dropped;    // per camera: images dropped at the tap (no free slot)
-  std::uint64_t not_written = 0;         // frames queued when writing failed or out of order
+  std::vector<std::uint64_t> dropped;  // per camera: images dropped at the tap (no free slot)
+  std::uint64_t not_written = 0;       // frames queued when writing failed or out of order
+  // per camera: frames written without its image (or blob list): dropped at the tap
+  // (`dropped`), or never delivered by the camera (a missed trigger, a missing file)
+  std::vector<std::uint64_t> without_image;
   std::uint64_t blob_lists_written = 0;  // blobs: chunks of the blob files
   std::uint64_t kept_skipped = 0;        // blobs: images to keep for which no buffer was free
 };
@@ -158,6 +161,7 @@ class FrameRecorder final : public pipeline::FrameTap, public pipeline::BlobTap 
   std::uint64_t base_sequence_ = 0;
 
   rt::Counter dropped_[kMaxCameras], frames_written_, images_written_, bytes_written_, not_written_;
+  rt::Counter without_image_[kMaxCameras];
   rt::Counter blob_lists_written_, kept_skipped_[kMaxCameras];  // kept_skipped_: detect threads
   std::atomic<std::uint64_t> seen_{0};
   std::atomic<bool> failed_{false};

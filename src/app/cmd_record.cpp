@@ -90,6 +90,31 @@ double camera_rate_mb_s(const record::RecorderOptions& o, double rate_hz) {
   return bytes * rate_hz / 1e6;
 }
 
+// Nothing lost silently: every frame triggered and not written, and every camera's frames
+// without its image (the writer was behind, the camera missed the trigger, a replay's file
+// was missing), in one line; a warning when anything was lost.
+void report_losses(std::uint64_t triggered, const record::RecorderCounts& k) {
+  std::string per_camera;
+  std::uint64_t without = 0;
+  for (std::size_t c = 0; c < k.without_image.size(); ++c) {
+    per_camera +=
+        (c > 0 ? ", cam" : "cam") + std::to_string(c) + " " + std::to_string(k.without_image[c]);
+    without += k.without_image[c];
+  }
+  const std::uint64_t not_written = triggered > k.frames_written ? triggered - k.frames_written : 0;
+  std::printf(
+      "mocap record: %llu frames triggered, %llu written, %llu not written; frames written "
+      "without a camera's image: %s\n",
+      static_cast<unsigned long long>(triggered), static_cast<unsigned long long>(k.frames_written),
+      static_cast<unsigned long long>(not_written), per_camera.c_str());
+  if (not_written > 0 || without > 0)
+    std::fprintf(stderr,
+                 "mocap record: warning: %llu triggered frames were not written and %llu camera "
+                 "images are missing from written frames (see the line above)\n",
+                 static_cast<unsigned long long>(not_written),
+                 static_cast<unsigned long long>(without));
+}
+
 int record(const RecordArgs& a) {
   if (auto r = check_args(a); !r) return fail(r.error().message);
   service::CliOverrides cli = a.cli;
@@ -243,6 +268,7 @@ int record(const RecordArgs& a) {
                  elapsed_s > 0.0 ? static_cast<double>(k.bytes_written) / 1e6 / elapsed_s : 0.0,
                  camera_rate_mb_s(ro, opt.trigger_rate_hz));
   }
+  report_losses((*pipe)->stats().triggered, k);
   if (!finished) {
     std::fprintf(stderr, "mocap: %s (the recording keeps the %llu frames written before)\n",
                  finished.error().message.c_str(),

@@ -134,7 +134,7 @@ TEST(HumanoidOutputs, FoxgloveSceneOfAllBodiesJointsAndCameras) {
   for (const foxglove::SceneJoint& j : scene->joints) EXPECT_TRUE(j.calibrated) << j.name;
   ASSERT_EQ(scene->cameras.size(), 8u);
   const auto channels = foxglove::live_view_channels(*scene);
-  EXPECT_EQ(channels.size(), 3u + 8u);
+  EXPECT_EQ(channels.size(), 4u + 8u);  // /tf /markers /joints /bodies + 8 cameras
   // The server takes every channel (a rig of 6..8 cameras used to be refused here).
   foxglove::ServerOptions o;
   o.port = 0;

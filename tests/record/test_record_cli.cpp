@@ -172,13 +172,17 @@ void expect_replay_recorded_whole(const std::string& source, const std::string& 
           << cam << "/" << name << " differs";
       ++files;
     }
-    EXPECT_EQ(
-        std::distance(fs::directory_iterator(copy + "/" + cam), fs::directory_iterator()),
-        std::distance(fs::directory_iterator(source + "/" + cam), fs::directory_iterator()));
+    EXPECT_EQ(std::distance(fs::directory_iterator(copy + "/" + cam), fs::directory_iterator()),
+              std::distance(fs::directory_iterator(source + "/" + cam), fs::directory_iterator()));
   }
   EXPECT_GE(files, 50);
   EXPECT_NE(r.output.find("30 frames (60 images"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("dropped images: cam0 0, cam1 0"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("30 frames triggered, 30 written, 0 not written; frames written "
+                          "without a camera's image: cam0 0, cam1 0"),
+            std::string::npos)
+      << r.output;
+  EXPECT_EQ(r.output.find("warning"), std::string::npos) << r.output;
   // The configuration's files are copied byte for byte.
   EXPECT_EQ(read_file(copy + "/model.yaml"), read_file(source + "/model.yaml"));
   EXPECT_EQ(read_file(copy + "/targets.yaml"), read_file(source + "/targets.yaml"));
@@ -208,6 +212,39 @@ TEST_F(RecordCli, MasterAndExternalSlaveReplayIsRecordedFrameForFrame) {
     SCOPED_TRACE("periodic");
     expect_replay_recorded_whole(source(), "external", "periodic");
   }
+}
+
+// A frame a camera did not deliver (here: the replay's file is missing) is counted in the
+// final line and warned about, never silently absent.
+TEST_F(RecordCli, AMissingImageIsCountedAndWarned) {
+  make_source();
+  ASSERT_TRUE(source_ok_) << source_log_;
+  TempDir dir("rec_missing");
+  const std::string src = dir.file("src");
+  fs::copy(source(), src, fs::copy_options::recursive);
+  ASSERT_TRUE(fs::remove(src + "/cam1/000007.pgm"));
+  write_file(dir.file("replay.yaml"),
+             "cameras:\n"
+             "  - {backend: replay, device: " +
+                 src +
+                 ", trigger: software}\n"
+                 "  - {backend: replay, device: " +
+                 src +
+                 ", trigger: software}\n"
+                 "pipeline: {pacing: lockstep, realtime: false, lock_memory: false}\n"
+                 "outputs: {udp: [], iceoryx: false}\n");
+  const RunResult r = run_mocap("record --config " + dir.file("replay.yaml") + " --out " +
+                                    dir.file("copy") + " --progress-interval 0",
+                                120);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("30 frames triggered, 30 written, 0 not written; frames written "
+                          "without a camera's image: cam0 0, cam1 1"),
+            std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("warning: 0 triggered frames were not written and 1 camera images"),
+            std::string::npos)
+      << r.output;
+  EXPECT_FALSE(fs::exists(dir.file("copy") + "/cam1/000007.pgm"));
 }
 
 // Runs mocap with stdout+stderr into `log`; optional RLIMIT_FSIZE (SIGXFSZ ignored, so a
