@@ -62,20 +62,20 @@ Iso3 noisy(const Iso3& T, double pos_sd_mm, double rot_sd_rad, std::mt19937& rng
   return out;
 }
 
-struct Score {
+struct BodyScore {
   double v_rms = 0.0, v_sd = 0.0, w_rms = 0.0, w_sd = 0.0;
   int rated = 0;
 };
 
 // 20 s of the motion with the given true noise; the filter is told stated_factor x it.
-Score track(double pos_sd_mm, double rot_sd_rad, double stated_factor) {
+BodyScore track(double pos_sd_mm, double rot_sd_rad, double stated_factor) {
   auto filter = BodyRateFilter::create({}, 1);
   EXPECT_TRUE(filter.ok());
   std::vector<BodyMeasurement> in(1);
   std::vector<BodyRate> out = filter->make_output();
   std::mt19937 rng(11);
   double sv = 0, ssv = 0, sw = 0, ssw = 0;
-  Score s;
+  BodyScore s;
   Motion m;
   for (int k = 0; k < 2000; ++k) {
     m.t_s = k * 0.01;
@@ -103,7 +103,7 @@ TEST(BodyRates, SmoothMotionWithRightAndWrongStatedNoise) {
   // small and 4x too large: kappa corrects the stated noise, the sd covers the error.
   for (const double factor : {1.0, 0.25, 4.0}) {
     SCOPED_TRACE(::testing::Message() << "stated x " << factor);
-    const Score s = track(0.1, 0.05 * kPiB / 180.0, factor);
+    const BodyScore s = track(0.1, 0.05 * kPiB / 180.0, factor);
     std::printf("stated x %.2f: v RMS %.2f mm/s (sd %.2f), w RMS %.3f deg/s (sd %.3f)\n", factor,
                 s.v_rms, s.v_sd, s.w_rms * 180.0 / kPiB, s.w_sd * 180.0 / kPiB);
     EXPECT_LT(s.v_rms, 30.0);                // mm/s, at speeds up to ~900 mm/s
