@@ -24,7 +24,16 @@
 #include "pipeline/publish/output_registry.h"
 #include "track/frame_processor.h"
 
+namespace mocap::node {
+class NodeLink;
+}
+
 namespace mocap::service {
+
+// Replay camera `position` of the configuration: the recording's camera named by
+// `camera: NAME` (settings.recording_camera), else the same position; one-line error.
+Expected<int> replay_camera_index(const Recording& recording, const config::CameraSettings& s,
+                                  int position, const std::string& where);
 
 // Command-line flags that override the configuration file (`mocap run`, `record`,
 // `preview`: src/app/config_flags.h). Unset: the configuration's value. No default and no
@@ -85,12 +94,17 @@ class LiveSetup {
   const config::TrackingAssets& assets() const noexcept { return assets_; }
   // One line per camera fallback (hal::Camera::notice), empty entries left out.
   std::vector<std::string> notices() const;
+  // Camera nodes (backend node): one line per node (messages, malformed, oversized,
+  // clock offset) and per node camera (missing, late, duplicates, reconnects); empty
+  // without node cameras. Report time.
+  std::string node_report() const;
 
  private:
   LiveSetup() = default;
   std::shared_ptr<const hal::SimFrameLoop> loop_;
   std::shared_ptr<hal::SimTrigger> trigger_;
   std::shared_ptr<const Recording> recording_;
+  std::shared_ptr<node::NodeLink> link_;  // backend node (pipeline/node/node_link.h)
   std::vector<std::unique_ptr<hal::Camera>> cams_;
   std::optional<FrameProcessor> processor_;
   config::TrackingAssets assets_;
