@@ -187,8 +187,10 @@ hal::CameraStatus NodeCamera::dequeue(hal::Frame& out, int timeout_ms) noexcept 
         }
         return hal::CameraStatus::kOk;
       }
-      if (down_ || eos_ || monotonic_ns() - trigger_ns_[next_ % kWindow] > timeout_ns_) {
-        if (eos_) return hal::CameraStatus::kEndOfStream;
+      if (eos_) return hal::CameraStatus::kEndOfStream;
+      // Missing: down, or late past the timeout, and some node answered this trigger.
+      if ((down_ || monotonic_ns() - trigger_ns_[next_ % kWindow] > timeout_ns_) &&
+          link_->received_end() > next_) {
         deliver_missing(out);
         return hal::CameraStatus::kOk;
       }

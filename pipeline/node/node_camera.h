@@ -10,7 +10,10 @@
 //     order, and survives the node: a frame not arrived `timeout_ms` after its trigger is
 //     delivered as MISSING (the set goes on with the other cameras); after 3 missing in a
 //     row the camera is down and its frames are missing at once, until a message of it
-//     arrives again (counted in node_reconnects). A message older than the next frame is
+//     arrives again (counted in node_reconnects). A frame is only declared missing once
+//     another node answered its trigger (NodeLink::received_end): when every node is
+//     silent nothing is invented, and a replay's end (answered by end-of-stream messages)
+//     ends the run instead of becoming a frame of missing cameras. A message older than the next frame is
 //     late, one already delivered a duplicate: counted and dropped.
 //   kExternal / kFreeRun: the node triggers (hardware line, or free-running): frames are
 //     delivered as they arrive (numbers must increase; older ones are late/duplicates).

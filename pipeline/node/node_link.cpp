@@ -67,6 +67,7 @@ Expected<void> NodeLink::start() {
   if (users_++ > 0) return {};
   stop_.store(false, std::memory_order_relaxed);  // no thread runs yet
   next_trigger_ = 0;
+  received_end_.store(0, std::memory_order_relaxed);  // no thread runs yet
   auto a = rt::start_thread(rt::ThreadSpec{"mocap-nrecv", -1, 0}, [this] { receive_loop(); });
   if (!a) return a.error();
   receive_thread_ = std::move(a).value();
@@ -184,6 +185,9 @@ void NodeLink::on_sample(const mocap_node_BlobFrame& s) noexcept {
   r.received_ns = now;
   estimate_offset(node, h, t3);
   if (h.sent_ns != 0) transit_.record(t3 - h.sent_ns);
+  if ((h.flags & kWireEndOfStream) == 0 &&
+      h.frame_number + 1 > received_end_.load(std::memory_order_relaxed))  // single writer
+    received_end_.store(h.frame_number + 1, std::memory_order_release);  // see received_end()
   pool.publish(slot);
   bell_.ring();
 }

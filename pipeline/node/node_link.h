@@ -70,7 +70,13 @@ class NodeLink {
   // lower number are ignored).
   void trigger(std::uint64_t number) noexcept;
 
-  // Any thread.
+  // Any thread: the highest frame number + 1 any camera's (valid, not end-of-stream)
+  // message carried. A NodeCamera declares a frame missing only below it: some node got
+  // that trigger and answered (so the replays' end, answered by end-of-stream messages
+  // only, never becomes a frame of missing cameras).
+  std::uint64_t received_end() const noexcept {
+    return received_end_.load(std::memory_order_acquire);  // pairs with on_sample()
+  }
   std::uint64_t unknown() const noexcept { return unknown_.get(); }
   std::uint64_t inbox_full(int k) const noexcept { return full_[static_cast<std::size_t>(k)]->get(); }
   const std::vector<std::unique_ptr<NodeStats>>& nodes() const noexcept { return nodes_; }
@@ -101,6 +107,7 @@ class NodeLink {
   std::uint64_t next_trigger_ = 0;  // capture thread: the lowest number not yet posted
   pipeline::Doorbell bell_, trigger_bell_;
   std::atomic<bool> stop_{false};
+  std::atomic<std::uint64_t> received_end_{0};  // receiver thread writes
   int users_ = 0;  // started cameras (setup thread)
   rt::RtThread receive_thread_, trigger_thread_;
   rt::Counter unknown_, triggers_sent_;
