@@ -97,7 +97,7 @@ std::uint32_t encode_blobs(const detect::BlobList& blobs, std::uint8_t* out,
   if (n > capacity / kBlobRecordBytes) n = capacity / kBlobRecordBytes;
   std::uint8_t* p = out;
   for (std::size_t i = 0; i < n; ++i) {
-    const detect::Blob& b = blobs[static_cast<int>(i)];
+    const detect::Blob& b = blobs[i];
     put(p, b.x_px);
     put(p, b.y_px);
     put(p, b.area_px);

@@ -20,6 +20,7 @@ int fuzz_model(const std::uint8_t* data, std::size_t size);          // model.ya
 int fuzz_frames_csv(const std::uint8_t* data, std::size_t size);     // frames.csv loader
 int fuzz_datagram(const std::uint8_t* data, std::size_t size);       // UDP datagram decoder
 int fuzz_blob_detector(const std::uint8_t* data, std::size_t size);  // detector on any image
+int fuzz_node_message(const std::uint8_t* data, std::size_t size);   // camera-node message
 
 struct FuzzTarget {
   const char* name;  // also the corpus folder name
@@ -30,6 +31,7 @@ inline constexpr FuzzTarget kFuzzTargets[] = {
     {"targets", fuzz_targets},   {"joints", fuzz_joints},
     {"model", fuzz_model},       {"frames_csv", fuzz_frames_csv},
     {"datagram", fuzz_datagram}, {"blob_detector", fuzz_blob_detector},
+    {"node_message", fuzz_node_message},
 };
 
 // Aborts with "fuzz invariant failed: <what>" (a finding in both builds).
