@@ -10,7 +10,10 @@
 // delivered) ends the triggering, as max_frames does. It owns no ring: each detect stage owns its
 // input and return rings; the capture holds their producer and consumer ends. run() is the hot
 // path: noexcept, allocation-free, lock-free, no logging; the only syscalls are the cameras'
-// trigger/dequeue/release and the trigger clock's sleep.
+// trigger/dequeue/release and the trigger clock's sleep. Lockstep pacing waits for the last
+// trigger's frame to be retired while polling the cameras every millisecond, so a frame that
+// came after its camera's dequeue timed out (a camera node's round trip) still completes
+// its set.
 #pragma once
 
 #include <array>
@@ -64,10 +67,18 @@ class CaptureStage {
   // trigger_ns: host time of the last software trigger (0: free-running cameras).
   void on_frame_received(int camera, const hal::Frame& frame, std::int64_t trigger_ns) noexcept;
   void setup_clock_checks(bool triggered_mode, std::int64_t period_ns) noexcept;
-  // Lockstep: waits (bounded) until `sequence` was retired.
-  void wait_retired(std::uint64_t sequence) noexcept;
+  // Lockstep: waits (bounded) until `sequence` was retired, polling the cameras meanwhile.
+  void wait_retired(std::uint64_t sequence, std::int64_t last_trigger_ns,
+                    bool& end_of_stream) noexcept;
+  // Dequeues camera c (the first call waits up to timeout_ms) and hands its frames to its
+  // detector; true when a frame was pushed. count_timeouts: an empty first dequeue counts
+  // in dequeue_timeouts_cam# (not for the polls while lockstep waits).
+  bool poll_camera(int c, int timeout_ms, bool triggered_mode, std::int64_t last_trigger_ns,
+                   std::uint64_t& last_sequence, bool& end_of_stream,
+                   bool count_timeouts) noexcept;
 
   static constexpr std::int64_t kLockstepTimeoutNs = 1'000'000'000;
+  static constexpr std::int64_t kLockstepPollNs = 1'000'000;  // cameras polled while waiting
 
   StageContext& context_;
   const std::vector<hal::Camera*> cameras_;

@@ -227,6 +227,15 @@ std::string NodeLink::report() const {
                   static_cast<double>(n->round_trip_ns.load(std::memory_order_relaxed)) / 1e3);
     out += line;
   }
+  const LatencyStats t = transit_.stats();
+  if (t.count > 0) {
+    char line[200];
+    std::snprintf(line, sizeof line,
+                  "nodes: transit node sent -> central received (CLOCK_REALTIME): %llu messages, "
+                  "p50 %.0f us, p99 %.0f us, max %.0f us\n",
+                  static_cast<unsigned long long>(t.count), t.p50_us, t.p99_us, t.max_us);
+    out += line;
+  }
   if (unknown_.get() > 0)
     out += "nodes: " + std::to_string(unknown_.get()) + " messages of unknown cameras dropped\n";
   return out;
