@@ -53,7 +53,7 @@ void CaptureStage::setup_clock_checks(bool triggered_mode, std::int64_t period_n
 
 void CaptureStage::finish_triggering() noexcept {
   if (context_.triggering_done()) return;
-  end_sequence_.store(delivered_end_, std::memory_order_relaxed);
+  end_sequence_.store(std::min(delivered_end_, ended_end_), std::memory_order_relaxed);
   context_.set_triggering_done();  // release: publishes end_sequence_ too
 }
 
@@ -158,6 +158,9 @@ bool CaptureStage::poll_camera(int c, int timeout_ms, bool triggered_mode,
       break;
     }
     if (st == hal::CameraStatus::kEndOfStream) {
+      // No set can complete from this camera's last frame on (cameras of different
+      // lengths: a camera node whose replay restarted).
+      ended_end_ = std::min(ended_end_, camera_end_[ci]);
       if (!triggered_mode) finish_triggering();
       end_of_stream = true;
       break;
@@ -206,6 +209,7 @@ void CaptureStage::on_frame_received(int camera, const hal::Frame& frame,
              static_cast<std::uint64_t>(std::max<std::int64_t>(now - last, 0) / 1000));
   context_.note_first_sequence(frame.sequence);
   delivered_end_ = std::max(delivered_end_, frame.sequence + 1);
+  camera_end_[c] = std::max(camera_end_[c], frame.sequence + 1);
 }
 
 void CaptureStage::report(rt::CounterReport& out) const {

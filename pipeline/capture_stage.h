@@ -42,7 +42,8 @@ class CaptureStage {
   // Any thread.
   std::uint64_t triggered() const noexcept { return counters_.triggered.get(); }
   // Once the triggering is done (StageContext::triggering_done()): the highest sequence
-  // the cameras delivered + 1, the sequence the pipeline must retire to be finished
+  // the cameras delivered + 1 (at most the end of the first camera whose stream ended:
+  // later sequences can never form a set), the sequence the pipeline must retire to be finished
   // (sequences are the cameras' own: a replay's start at its recording's first frame).
   std::uint64_t end_sequence() const noexcept {
     // relaxed: read after StageContext::triggering_done() (acquire), which it precedes.
@@ -89,6 +90,9 @@ class CaptureStage {
   std::array<std::atomic<std::int64_t>, kMaxCameras> last_frame_ns_{};  // this thread writes
   void finish_triggering() noexcept;
   std::uint64_t delivered_end_ = 0;             // highest sequence dequeued + 1 (this thread)
+  std::array<std::uint64_t, kMaxCameras> camera_end_{};  // the same per camera (this thread)
+  // The lowest camera_end_ of the cameras that reached their end of stream (this thread).
+  std::uint64_t ended_end_ = ~std::uint64_t{0};
   std::atomic<std::uint64_t> end_sequence_{0};  // delivered_end_ when the triggering ended
 
   struct alignas(64) Counters {

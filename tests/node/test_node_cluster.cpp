@@ -4,7 +4,7 @@
 // them. Checked against the same recording replayed in one process: every frame is
 // published and the joint angles (UDP datagrams) are equal within 1e-5 rad; with one node
 // killed mid-run the central goes on publishing from the other node's cameras and ends
-// normally when the replay ends. Each test uses its own DDS domain id (no cross-talk
+// normally when the replay ends; the node restarted is used again. Each test uses its own DDS domain id (no cross-talk
 // between concurrent test processes).
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -91,15 +91,22 @@ class NodeCluster : public ::testing::Test {
     write("central.yaml", y + tracker_keys(port, rate_hz));
   }
   // Both nodes in the background, the central in the foreground; `kill_after_s` > 0
-  // SIGKILLs node n1 that long after the central started.
-  test::RunResult run_cluster(double kill_after_s) {
+  // SIGKILLs node n1 that long after the central started, `restart_after_s` > 0 starts it
+  // again that much later (its replay starts at its first frame again).
+  test::RunResult run_cluster(double kill_after_s, double restart_after_s = 0.0) {
     const std::string m = test::mocap_binary();
     const std::string d = "'" + dir_ + "'";
     std::string cmd = "cd " + d + " && " + m + " node --config node0.yaml --duration 120 > node0.log 2>&1 & " +
                       "cd " + d + " && " + m + " node --config node1.yaml --duration 120 > node1.log 2>&1 & B=$!; ";
-    if (kill_after_s > 0) cmd += "(sleep " + std::to_string(kill_after_s) + "; kill -9 $B) & ";
+    if (kill_after_s > 0) {
+      cmd += "(sleep " + std::to_string(kill_after_s) + "; kill -9 $B";
+      if (restart_after_s > 0)
+        cmd += "; sleep " + std::to_string(restart_after_s) + "; cd " + d + " && { " + m +
+               " node --config node1.yaml --duration 20 > node1b.log 2>&1 & echo $! > node1b.pid; }";
+      cmd += ") & ";
+    }
     cmd += "timeout 120 " + m + " run --config " + d + "/central.yaml --stats-interval 0 > " + d +
-           "/central.log 2>&1; rc=$?; wait; cat " + d + "/central.log " + d + "/node0.log; exit $rc";
+           "/central.log 2>&1; rc=$?; wait; [ -f " + d + "/node1b.pid ] && kill $(cat " + d + "/node1b.pid); cat " + d + "/central.log " + d + "/node0.log; exit $rc";
     return test::run_command(cmd);
   }
   std::string dir_;
@@ -143,11 +150,11 @@ TEST_F(NodeCluster, TwoNodesPublishEveryFrameWithTheSingleProcessAngles) {
   EXPECT_LE(worst, 1e-5);
 }
 
-TEST_F(NodeCluster, AKilledNodesCamerasGoMissingAndTheRunEndsNormally) {
+TEST_F(NodeCluster, AKilledNodesCamerasGoMissingComeBackAndTheRunEndsNormally) {
   test::KeepAllUdpSocket sock(300'000);
   ASSERT_TRUE(sock.ok());
-  write_cluster(sock.port(), 20.0);  // 20 Hz: the kill lands mid-run
-  const test::RunResult r = run_cluster(0.4 * kFrames / 20.0 + 0.5);
+  write_cluster(sock.port(), 10.0);  // 10 Hz: the kill and the restart land mid-run
+  const test::RunResult r = run_cluster(0.3 * kFrames / 10.0 + 0.5, 0.3);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("the recording ended"), std::string::npos) << r.output;
   const Published got = drain(sock);
@@ -161,6 +168,10 @@ TEST_F(NodeCluster, AKilledNodesCamerasGoMissingAndTheRunEndsNormally) {
   const std::size_t missing = r.output.find("missing ", at);
   ASSERT_NE(missing, std::string::npos) << r.output;
   EXPECT_GT(std::stol(r.output.substr(missing + 8)), 0) << r.output;
+  // The node came back (a new process) and its cameras were used again.
+  const std::size_t reconnects = r.output.find("reconnects ", at);
+  ASSERT_NE(reconnects, std::string::npos) << r.output;
+  EXPECT_GT(std::stol(r.output.substr(reconnects + 11)), 0) << r.output;
 }
 
 }  // namespace
