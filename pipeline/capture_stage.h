@@ -75,8 +75,7 @@ class CaptureStage {
   // detector; true when a frame was pushed. count_timeouts: an empty first dequeue counts
   // in dequeue_timeouts_cam# (not for the polls while lockstep waits).
   bool poll_camera(int c, int timeout_ms, bool triggered_mode, std::int64_t last_trigger_ns,
-                   std::uint64_t& last_sequence, bool& end_of_stream,
-                   bool count_timeouts) noexcept;
+                   std::uint64_t& last_sequence, bool& end_of_stream, bool count_timeouts) noexcept;
 
   static constexpr std::int64_t kLockstepTimeoutNs = 1'000'000'000;
   static constexpr std::int64_t kLockstepPollNs = 1'000'000;  // cameras polled while waiting
@@ -89,7 +88,7 @@ class CaptureStage {
   std::array<TimestampCheck, kMaxCameras> clock_checks_{};  // this thread (set in run())
   std::array<std::atomic<std::int64_t>, kMaxCameras> last_frame_ns_{};  // this thread writes
   void finish_triggering() noexcept;
-  std::uint64_t delivered_end_ = 0;             // highest sequence dequeued + 1 (this thread)
+  std::uint64_t delivered_end_ = 0;  // highest sequence dequeued + 1 (this thread)
   std::array<std::uint64_t, kMaxCameras> camera_end_{};  // the same per camera (this thread)
   // The lowest camera_end_ of the cameras that reached their end of stream (this thread).
   std::uint64_t ended_end_ = ~std::uint64_t{0};

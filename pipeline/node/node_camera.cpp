@@ -15,8 +15,9 @@ Expected<std::unique_ptr<NodeCamera>> NodeCamera::open(std::shared_ptr<NodeLink>
       device.find('/', slash + 1) != std::string::npos)
     return make_error(device, "device", "expected NODE/CAMERA");
   if (max_blobs < 1 || max_blobs > static_cast<int>(kMaxBlobsPerMessage))
-    return make_error(device, "detection.max_blobs",
-                      "must be in 1.." + std::to_string(kMaxBlobsPerMessage) + " with node cameras");
+    return make_error(
+        device, "detection.max_blobs",
+        "must be in 1.." + std::to_string(kMaxBlobsPerMessage) + " with node cameras");
   auto k = link->add_camera(device.substr(0, slash), device.substr(slash + 1), 32, max_blobs);
   if (!k) return k.error();
   return std::unique_ptr<NodeCamera>(new NodeCamera(std::move(link), *k, device, timeout_ms));
@@ -135,7 +136,8 @@ void NodeCamera::deliver_held(hal::Frame& out) noexcept {
   out.missing = (r.header.flags & kWireMissing) != 0;
   out.blobs = out.missing ? nullptr : &r.blobs;
   if (have_last_ && k > last_number_)
-    period_ns_ = (r.header.capture_ns - last_capture_ns_) / static_cast<std::int64_t>(k - last_number_);
+    period_ns_ =
+        (r.header.capture_ns - last_capture_ns_) / static_cast<std::int64_t>(k - last_number_);
   have_last_ = true;
   last_number_ = k;
   last_capture_ns_ = r.header.capture_ns;

@@ -13,8 +13,8 @@
 //     arrives again (counted in node_reconnects). A frame is only declared missing once
 //     another node answered its trigger (NodeLink::received_end): when every node is
 //     silent nothing is invented, and a replay's end (answered by end-of-stream messages)
-//     ends the run instead of becoming a frame of missing cameras. A message older than the next frame is
-//     late, one already delivered a duplicate: counted and dropped.
+//     ends the run instead of becoming a frame of missing cameras. A message older than the next
+//     frame is late, one already delivered a duplicate: counted and dropped.
 //   kExternal / kFreeRun: the node triggers (hardware line, or free-running): frames are
 //     delivered as they arrive (numbers must increase; older ones are late/duplicates).
 // The node's end of stream (its replay ended) is this camera's kEndOfStream.
@@ -66,12 +66,12 @@ class NodeCamera final : public hal::CameraBase {
   bool eos_ = false;     // the node's end-of-stream message arrived
   bool down_ = false;
   int missing_run_ = 0;
-  std::uint64_t triggered_ = 0;  // central triggers posted
-  std::uint64_t next_ = 0;       // next frame number to deliver (central mode)
-  std::int64_t trigger_ns_[kWindow] = {};      // CLOCK_MONOTONIC of trigger k % kWindow
+  std::uint64_t triggered_ = 0;                 // central triggers posted
+  std::uint64_t next_ = 0;                      // next frame number to deliver (central mode)
+  std::int64_t trigger_ns_[kWindow] = {};       // CLOCK_MONOTONIC of trigger k % kWindow
   std::uint64_t delivered_real_[kWindow] = {};  // k + 1 when frame k was delivered real
   bool have_last_ = false;
-  std::uint64_t last_number_ = 0;   // last real frame number delivered
+  std::uint64_t last_number_ = 0;  // last real frame number delivered
   std::int64_t last_capture_ns_ = 0, period_ns_ = 0;
   bool held_valid_ = false;
   rt::SlotHandle held_ = 0;

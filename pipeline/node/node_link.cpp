@@ -162,7 +162,8 @@ void NodeLink::on_sample(const mocap_node_BlobFrame& s) noexcept {
     unknown_.add();
     return;
   }
-  NodeStats& node = *nodes_[static_cast<std::size_t>(cameras_[static_cast<std::size_t>(k)].node_index)];
+  NodeStats& node =
+      *nodes_[static_cast<std::size_t>(cameras_[static_cast<std::size_t>(k)].node_index)];
   node.messages.add();
   rt::SlotPool<Received>& pool = *inboxes_[static_cast<std::size_t>(k)];
   const auto ki = static_cast<std::size_t>(k);
@@ -187,7 +188,7 @@ void NodeLink::on_sample(const mocap_node_BlobFrame& s) noexcept {
   if (h.sent_ns != 0) transit_.record(t3 - h.sent_ns);
   if ((h.flags & kWireEndOfStream) == 0 &&
       h.frame_number + 1 > received_end_.load(std::memory_order_relaxed))  // single writer
-    received_end_.store(h.frame_number + 1, std::memory_order_release);  // see received_end()
+    received_end_.store(h.frame_number + 1, std::memory_order_release);    // see received_end()
   pool.publish(slot);
   bell_.ring();
 }
@@ -201,8 +202,8 @@ void NodeLink::estimate_offset(NodeStats& n, const WireHeader& h, std::int64_t t
   }
   // The best sample of the current window of 256 (the smallest round trip; one-way
   // samples only while no round trip is known) is the estimate, published as it improves.
-  const bool better = n.window_count == 0 ||
-                      (rtt >= 0 && (n.window_best_rtt < 0 || rtt < n.window_best_rtt));
+  const bool better =
+      n.window_count == 0 || (rtt >= 0 && (n.window_best_rtt < 0 || rtt < n.window_best_rtt));
   if (better) {
     n.window_best_rtt = rtt;
     n.window_offset = offset;

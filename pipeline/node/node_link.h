@@ -42,8 +42,8 @@ struct Received {
 struct NodeStats {
   std::string name;
   rt::Counter messages, malformed, oversized;
-  std::atomic<std::int64_t> offset_ns{0};  // node minus central CLOCK_REALTIME
-  std::atomic<std::int64_t> round_trip_ns{-1};  // of that estimate; -1: one-way / none
+  std::atomic<std::int64_t> offset_ns{0};                // node minus central CLOCK_REALTIME
+  std::atomic<std::int64_t> round_trip_ns{-1};           // of that estimate; -1: one-way / none
   std::int64_t window_best_rtt = -1, window_offset = 0;  // receiver thread
   int window_count = 0;
 };
@@ -55,8 +55,8 @@ class NodeLink {
 
   // Setup (before start): camera `camera` of node `node`; its inbox holds `slots`
   // messages of up to `max_blobs` blobs. Returns the camera's index here.
-  Expected<int> add_camera(const std::string& node, const std::string& camera,
-                           std::uint32_t slots, int max_blobs);
+  Expected<int> add_camera(const std::string& node, const std::string& camera, std::uint32_t slots,
+                           int max_blobs);
   rt::SlotPool<Received>& inbox(int k) noexcept { return *inboxes_[static_cast<std::size_t>(k)]; }
   pipeline::Doorbell& bell() noexcept { return bell_; }
 
@@ -78,7 +78,9 @@ class NodeLink {
     return received_end_.load(std::memory_order_acquire);  // pairs with on_sample()
   }
   std::uint64_t unknown() const noexcept { return unknown_.get(); }
-  std::uint64_t inbox_full(int k) const noexcept { return full_[static_cast<std::size_t>(k)]->get(); }
+  std::uint64_t inbox_full(int k) const noexcept {
+    return full_[static_cast<std::size_t>(k)]->get();
+  }
   const std::vector<std::unique_ptr<NodeStats>>& nodes() const noexcept { return nodes_; }
   const LatencyHistogram& transit() const noexcept { return transit_; }  // node sent -> received
   std::string report() const;  // one line per node (report time)
@@ -108,7 +110,7 @@ class NodeLink {
   pipeline::Doorbell bell_, trigger_bell_;
   std::atomic<bool> stop_{false};
   std::atomic<std::uint64_t> received_end_{0};  // receiver thread writes
-  int users_ = 0;  // started cameras (setup thread)
+  int users_ = 0;                               // started cameras (setup thread)
   rt::RtThread receive_thread_, trigger_thread_;
   rt::Counter unknown_, triggers_sent_;
   LatencyHistogram transit_;

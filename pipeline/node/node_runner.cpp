@@ -14,11 +14,13 @@ Expected<std::unique_ptr<NodeRunner>> NodeRunner::create(std::vector<NodeCameraS
                                                          NodeSender& sender) {
   const int n = static_cast<int>(cameras.size());
   if (n < 1 || n > kMaxNodeCameras)
-    return make_error("mocap node", "cameras",
-                      std::to_string(n) + " cameras, expected 1.." + std::to_string(kMaxNodeCameras));
+    return make_error(
+        "mocap node", "cameras",
+        std::to_string(n) + " cameras, expected 1.." + std::to_string(kMaxNodeCameras));
   if (detect.max_blobs > static_cast<int>(kMaxBlobsPerMessage))
-    return make_error("mocap node", "detection.max_blobs",
-                      "at most " + std::to_string(kMaxBlobsPerMessage) + " on a node (one message)");
+    return make_error(
+        "mocap node", "detection.max_blobs",
+        "at most " + std::to_string(kMaxBlobsPerMessage) + " on a node (one message)");
   if (!(options.trigger_rate_hz > 0.0))
     return make_error("mocap node", "pipeline.trigger_rate_hz", "must be > 0");
   std::unique_ptr<NodeRunner> r(new NodeRunner(std::move(cameras), options, sender));
@@ -176,8 +178,8 @@ void NodeRunner::run(int c) noexcept {
         next_ns += period_ns;
         if (next_ns < now) next_ns = now + period_ns;  // overran: re-phase
       }
-      timeout_ms = static_cast<int>(
-          std::clamp<std::int64_t>((next_ns - monotonic_ns()) / 1'000'000, 0, 20));
+      timeout_ms =
+          static_cast<int>(std::clamp<std::int64_t>((next_ns - monotonic_ns()) / 1'000'000, 0, 20));
     }
     hal::Frame f;
     const hal::CameraStatus s = cam.dequeue(f, timeout_ms);

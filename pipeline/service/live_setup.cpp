@@ -106,7 +106,7 @@ pipeline::PipelineOptions pipeline_options(const config::RunConfig& cfg) {
   o.cpu_latency_us = cfg.pipeline.cpu_latency_us;
   o.dequeue_timeout_ms = cfg.pipeline.dequeue_timeout_ms;
   o.pair_by = cfg.pipeline.pair_by == config::PairBy::kTimestamp ? pipeline::PairBy::kTimestamp
-                                                                  : pipeline::PairBy::kSequence;
+                                                                 : pipeline::PairBy::kSequence;
   o.pair_tolerance_us = cfg.pipeline.pair_tolerance_us;
   for (std::size_t i = 0; i < config::kStageCount; ++i) {
     const config::StageSettings& s = cfg.pipeline.stages[i];
@@ -196,8 +196,7 @@ Expected<std::unique_ptr<LiveSetup>> LiveSetup::create(const config::RunConfig& 
       auto index = replay_camera_index(*s->recording_, cfg.cameras[static_cast<std::size_t>(c)], c,
                                        cfg.path.empty() ? std::string(command) : cfg.path);
       if (!index) return index.error();
-      auto cam =
-          hal::ReplayCamera::open(s->recording_, *index, hal::ReplayPacing::kRecordedTiming);
+      auto cam = hal::ReplayCamera::open(s->recording_, *index, hal::ReplayPacing::kRecordedTiming);
       if (!cam) return cam.error();
       native[static_cast<std::size_t>(c)] = (*cam)->native_config();
       cams[static_cast<std::size_t>(c)] = std::move(cam).value();
@@ -300,9 +299,9 @@ Expected<int> replay_camera_index(const Recording& recording, const config::Came
     if (cams[i].name == s.recording_camera) return static_cast<int>(i);
     names += (i ? ", " : "") + cams[i].name;
   }
-  return make_error(where, "cameras[" + std::to_string(position) + "].camera",
-                    "the recording has no camera '" + s.recording_camera + "' (it has " + names +
-                        ")");
+  return make_error(
+      where, "cameras[" + std::to_string(position) + "].camera",
+      "the recording has no camera '" + s.recording_camera + "' (it has " + names + ")");
 }
 
 std::string LiveSetup::node_report() const {

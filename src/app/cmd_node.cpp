@@ -123,7 +123,8 @@ int run_node(const NodeArgs& a) {
   sigaction(SIGTERM, &sa, nullptr);
   if (auto r = (*sender)->start(); !r) return fail(r.error().message);
   if (auto r = (*runner)->start(); !r) return fail(r.error().message);
-  for (const std::string& n : (*runner)->notes()) std::fprintf(stderr, "mocap node: note: %s\n", n.c_str());
+  for (const std::string& n : (*runner)->notes())
+    std::fprintf(stderr, "mocap node: note: %s\n", n.c_str());
   std::fprintf(stderr, "mocap node: %s publishing %zu cameras on DDS domain %u\n", name.c_str(),
                specs.size(), cfg->node.domain_id);
   const auto t0 = std::chrono::steady_clock::now();

@@ -64,7 +64,8 @@ void read_camera(const YAML::Node& node, const std::string& where, const std::st
   const bool native = cam.backend == CameraBackend::kSim || cam.backend == CameraBackend::kReplay;
   if (const auto d = s.text("device")) {
     if (cam.backend == CameraBackend::kSim) s.bad("device", "not used by the sim backend");
-    const bool named = cam.backend == CameraBackend::kLibcamera || cam.backend == CameraBackend::kNode;
+    const bool named =
+        cam.backend == CameraBackend::kLibcamera || cam.backend == CameraBackend::kNode;
     cam.device = named ? *d : resolve(dir, *d);
   } else if (cam.backend != CameraBackend::kSim) {
     fail(s.path("device"), std::string("missing key (the ") + backend + " backend needs " +
@@ -94,8 +95,7 @@ void read_camera(const YAML::Node& node, const std::string& where, const std::st
   if (const auto v = s.integer("buffers", 2, 64)) cam.buffers = static_cast<int>(*v);
 }
 
-void read_cameras(const YAML::Node& node, const std::string& dir, RunConfig& cfg,
-                  ConfigRole role) {
+void read_cameras(const YAML::Node& node, const std::string& dir, RunConfig& cfg, ConfigRole role) {
   formats_detail::require_list(node, "cameras");
   const std::size_t n = node.size();
   const std::size_t lo = role == ConfigRole::kNode ? 1 : static_cast<std::size_t>(kMinCameras);
@@ -431,7 +431,8 @@ Expected<RunConfig> load_run_config(const std::string& path, bool targets_requir
     return parse(path, root, role);
   });
   if (!cfg) return cfg;
-  if (role == ConfigRole::kNode) return cfg;  // no tracker on a node: `mocap node` opens the cameras
+  if (role == ConfigRole::kNode)
+    return cfg;  // no tracker on a node: `mocap node` opens the cameras
   if (auto r = check_tracking_assets(*cfg, targets_required); !r) return r.error();
   return cfg;
 }

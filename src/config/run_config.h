@@ -131,10 +131,10 @@ struct FaultSettings {
 // `node:` (docs/operations.md, "Several PCs"): on a `mocap node`, its name and DDS domain;
 // on the central tracker (cameras of backend node), the domain and the fault timing.
 struct NodeSettings {
-  std::string name;         // empty: the host name (mocap node)
+  std::string name;  // empty: the host name (mocap node)
   std::uint32_t domain_id = 0;
-  int timeout_ms = 100;     // central: a frame not arrived this long after its trigger is missing
-  double wait_s = 10.0;     // central: how long start waits for every node to be discovered
+  int timeout_ms = 100;  // central: a frame not arrived this long after its trigger is missing
+  double wait_s = 10.0;  // central: how long start waits for every node to be discovered
 };
 
 // Which command reads the configuration: `mocap node` takes 1..8 cameras of its own PC

@@ -22,8 +22,9 @@ void read_node_camera_keys(const Section& s, config::CameraSettings& cam) {
   if (t && *t == "central") {
     if (cam.backend != CameraBackend::kReplay && cam.backend != CameraBackend::kV4l2 &&
         cam.backend != CameraBackend::kLibcamera)
-      s.bad("trigger", std::string("'central' needs a replay or software-triggerable camera, not ") +
-                           config::to_string(cam.backend));
+      s.bad("trigger",
+            std::string("'central' needs a replay or software-triggerable camera, not ") +
+                config::to_string(cam.backend));
     cam.central_trigger = true;
     cam.trigger = TriggerMode::kSoftware;
   } else if (t) {
@@ -41,8 +42,8 @@ void read_node_camera_keys(const Section& s, config::CameraSettings& cam) {
     const std::size_t slash = cam.device.find('/');
     if (slash == std::string::npos || slash == 0 || slash + 1 == cam.device.size() ||
         cam.device.find('/', slash + 1) != std::string::npos || cam.device.size() > 127)
-      s.bad("device", "expected NODE/CAMERA (the node's name, its camera's name), got '" +
-                          cam.device + "'");
+      s.bad("device",
+            "expected NODE/CAMERA (the node's name, its camera's name), got '" + cam.device + "'");
   }
 }
 
@@ -62,8 +63,9 @@ void read_node_section(const YAML::Node& node, config::NodeSettings& n) {
 }
 
 void read_pair_keys(const Section& s, config::PipelineSettings& p) {
-  if (const auto v = s.choice<config::PairBy>("pair_by", {{"sequence", config::PairBy::kSequence},
-                                                          {"timestamp", config::PairBy::kTimestamp}}))
+  if (const auto v = s.choice<config::PairBy>(
+          "pair_by",
+          {{"sequence", config::PairBy::kSequence}, {"timestamp", config::PairBy::kTimestamp}}))
     p.pair_by = *v;
   if (const auto v = s.integer("pair_tolerance_us", 1, 1'000'000))
     p.pair_tolerance_us = static_cast<int>(*v);

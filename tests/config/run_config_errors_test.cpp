@@ -35,7 +35,8 @@ const ErrorCase kCases[] = {
     {"CentralTriggerOnTheCentral",
      "cameras: [{backend: replay, device: r, trigger: central}, {backend: replay, device: r}]\n",
      "cameras[0].trigger: 'central' is for the cameras of a `mocap node` (line 1)"},
-    {"NodeDeviceWithoutSlash", "cameras: [{backend: node, device: a}, {backend: node, device: b/c}]\n",
+    {"NodeDeviceWithoutSlash",
+     "cameras: [{backend: node, device: a}, {backend: node, device: b/c}]\n",
      "cameras[0].device: expected NODE/CAMERA (the node's name, its camera's name), got 'a' "
      "(line 1)"},
     {"RecordingCameraNotReplay", "cameras: [{backend: sim, camera: x}, {backend: sim}]\n",

@@ -27,10 +27,14 @@ struct FuzzTarget {
   int (*entry)(const std::uint8_t*, std::size_t);
 };
 inline constexpr FuzzTarget kFuzzTargets[] = {
-    {"pgm", fuzz_pgm},           {"rig", fuzz_rig},
-    {"targets", fuzz_targets},   {"joints", fuzz_joints},
-    {"model", fuzz_model},       {"frames_csv", fuzz_frames_csv},
-    {"datagram", fuzz_datagram}, {"blob_detector", fuzz_blob_detector},
+    {"pgm", fuzz_pgm},
+    {"rig", fuzz_rig},
+    {"targets", fuzz_targets},
+    {"joints", fuzz_joints},
+    {"model", fuzz_model},
+    {"frames_csv", fuzz_frames_csv},
+    {"datagram", fuzz_datagram},
+    {"blob_detector", fuzz_blob_detector},
     {"node_message", fuzz_node_message},
 };
 

@@ -4,8 +4,8 @@
 // them. Checked against the same recording replayed in one process: every frame is
 // published and the joint angles (UDP datagrams) are equal within 1e-5 rad; with one node
 // killed mid-run the central goes on publishing from the other node's cameras and ends
-// normally when the replay ends; the node restarted is used again. Each test uses its own DDS domain id (no cross-talk
-// between concurrent test processes).
+// normally when the replay ends; the node restarted is used again. Each test uses its own DDS
+// domain id (no cross-talk between concurrent test processes).
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -76,15 +76,16 @@ class NodeCluster : public ::testing::Test {
   }
   void write_cluster(int port, double rate_hz) {
     for (int n = 0; n < 2; ++n) {
-      std::string y = "node: {name: n" + std::to_string(n) + ", domain_id: " +
-                      std::to_string(domain_) + "}\npipeline: {realtime: false}\ncameras:\n";
+      std::string y = "node: {name: n" + std::to_string(n) +
+                      ", domain_id: " + std::to_string(domain_) +
+                      "}\npipeline: {realtime: false}\ncameras:\n";
       for (int c = 4 * n; c < 4 * n + 4; ++c)
         y += "  - {backend: replay, device: " + recording() + ", camera: cam" + std::to_string(c) +
              ", trigger: central}\n";
       write("node" + std::to_string(n) + ".yaml", y);
     }
-    std::string y = "node: {domain_id: " + std::to_string(domain_) + ", wait_s: 20}\nrig: " +
-                    recording() + "/rig.yaml\ncameras:\n";
+    std::string y = "node: {domain_id: " + std::to_string(domain_) +
+                    ", wait_s: 20}\nrig: " + recording() + "/rig.yaml\ncameras:\n";
     for (int c = 0; c < 8; ++c)
       y += "  - {backend: node, device: n" + std::to_string(c / 4) + "/cam" + std::to_string(c) +
            "}\n";
@@ -96,17 +97,21 @@ class NodeCluster : public ::testing::Test {
   test::RunResult run_cluster(double kill_after_s, double restart_after_s = 0.0) {
     const std::string m = test::mocap_binary();
     const std::string d = "'" + dir_ + "'";
-    std::string cmd = "cd " + d + " && " + m + " node --config node0.yaml --duration 120 > node0.log 2>&1 & " +
-                      "cd " + d + " && " + m + " node --config node1.yaml --duration 120 > node1.log 2>&1 & B=$!; ";
+    std::string cmd = "cd " + d + " && " + m +
+                      " node --config node0.yaml --duration 120 > node0.log 2>&1 & " + "cd " + d +
+                      " && " + m +
+                      " node --config node1.yaml --duration 120 > node1.log 2>&1 & B=$!; ";
     if (kill_after_s > 0) {
       cmd += "(sleep " + std::to_string(kill_after_s) + "; kill -9 $B";
       if (restart_after_s > 0)
-        cmd += "; sleep " + std::to_string(restart_after_s) + "; cd " + d + " && { " + m +
-               " node --config node1.yaml --duration 20 > node1b.log 2>&1 & echo $! > node1b.pid; }";
+        cmd +=
+            "; sleep " + std::to_string(restart_after_s) + "; cd " + d + " && { " + m +
+            " node --config node1.yaml --duration 20 > node1b.log 2>&1 & echo $! > node1b.pid; }";
       cmd += ") & ";
     }
     cmd += "timeout 120 " + m + " run --config " + d + "/central.yaml --stats-interval 0 > " + d +
-           "/central.log 2>&1; rc=$?; wait; [ -f " + d + "/node1b.pid ] && kill $(cat " + d + "/node1b.pid); cat " + d + "/central.log " + d + "/node0.log; exit $rc";
+           "/central.log 2>&1; rc=$?; wait; [ -f " + d + "/node1b.pid ] && kill $(cat " + d +
+           "/node1b.pid); cat " + d + "/central.log " + d + "/node0.log; exit $rc";
     return test::run_command(cmd);
   }
   std::string dir_;
@@ -120,8 +125,8 @@ TEST_F(NodeCluster, TwoNodesPublishEveryFrameWithTheSingleProcessAngles) {
   for (int c = 0; c < 8; ++c)
     single += "  - {backend: replay, device: " + recording() + ", trigger: software}\n";
   write("single.yaml", single + tracker_keys(single_sock.port(), 100.0));
-  const test::RunResult one = test::run_mocap(
-      "run --config '" + dir_ + "/single.yaml' --stats-interval 0", 120);
+  const test::RunResult one =
+      test::run_mocap("run --config '" + dir_ + "/single.yaml' --stats-interval 0", 120);
   ASSERT_EQ(one.exit_code, 0) << one.output;
   const Published ref = drain(single_sock);
   ASSERT_EQ(static_cast<int>(ref.angles.size()), kFrames) << one.output;
@@ -163,7 +168,8 @@ TEST_F(NodeCluster, AKilledNodesCamerasGoMissingComeBackAndTheRunEndsNormally) {
   EXPECT_NE(r.output.find("node:n1/cam4: frames"), std::string::npos) << r.output;
   EXPECT_EQ(r.output.find("node:n1/cam4: frames " + std::to_string(kFrames) + ","),
             std::string::npos)
-      << "node n1 was not killed mid-run\n" << r.output;
+      << "node n1 was not killed mid-run\n"
+      << r.output;
   const std::size_t at = r.output.find("node:n1/cam4: frames");
   const std::size_t missing = r.output.find("missing ", at);
   ASSERT_NE(missing, std::string::npos) << r.output;

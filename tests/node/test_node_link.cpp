@@ -106,11 +106,11 @@ TEST_F(NodeLinkTest, DeliversInOrderAndCountsEveryBadMessage) {
     ASSERT_EQ(cams_[1]->trigger(), hal::CameraStatus::kOk);
   }
   send("n0", "cam0", 0, 3);
-  send("n0", "cam0", 0, 3);                 // duplicate
-  send("n0", "cam0", 1, 2, 7);              // malformed: version 7
-  send("n0", "cam0", 1, 5);                 // oversized: 5 > max_blobs 4
-  send("n9", "cam0", 1, 1);                 // unknown node
-  send("n0", "cam0", 2, 1);                 // frame 1 never comes: 2 first
+  send("n0", "cam0", 0, 3);     // duplicate
+  send("n0", "cam0", 1, 2, 7);  // malformed: version 7
+  send("n0", "cam0", 1, 5);     // oversized: 5 > max_blobs 4
+  send("n9", "cam0", 1, 1);     // unknown node
+  send("n0", "cam0", 2, 1);     // frame 1 never comes: 2 first
   send("n1", "cam1", 0, 1);
   send("n1", "cam1", 1, 1);
   send("n1", "cam1", 2, 1);
