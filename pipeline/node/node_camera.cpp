@@ -129,6 +129,12 @@ void NodeCamera::deliver_held(hal::Frame& out) noexcept {
   out = hal::Frame{};
   out.sequence = k;
   out.timestamp_ns = r.header.capture_ns;
+  if ((r.header.flags & kWireReplay) == 0 && r.header.realtime_offset_ns != 0) {
+    // A live camera's CLOCK_MONOTONIC on the node -> this host's, through CLOCK_REALTIME
+    // (PTP-synchronised across the PCs: pair_by timestamp compares these).
+    const std::int64_t central_offset = realtime_ns() - monotonic_ns();
+    out.timestamp_ns += r.header.realtime_offset_ns - central_offset;
+  }
   out.received_ns = r.received_ns;
   // The latencies start at the central trigger (the node's round trip included).
   out.delivered_ns = central_ ? trigger_ns_[k % kWindow] : r.received_ns;

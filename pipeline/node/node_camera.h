@@ -18,6 +18,10 @@
 //   kExternal / kFreeRun: the node triggers (hardware line, or free-running): frames are
 //     delivered as they arrive (numbers must increase; older ones are late/duplicates).
 // The node's end of stream (its replay ended) is this camera's kEndOfStream.
+// Capture times: a replay's stay the recording's; a live camera's (node CLOCK_MONOTONIC)
+// are mapped onto this host's CLOCK_MONOTONIC through CLOCK_REALTIME (both hosts'
+// realtime - monotonic offsets; PTP keeps the realtime clocks together), so that
+// `pair_by: timestamp` compares the nodes' frames on one clock.
 // Hot-path calls are noexcept, lock-free and allocation-free (capture thread only).
 #pragma once
 

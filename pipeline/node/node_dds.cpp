@@ -84,6 +84,7 @@ void to_sample(const WireHeader& h, mocap_node_BlobFrame& s) noexcept {
   s.trigger_received_ns = h.trigger_received_ns;
   s.sent_ns = h.sent_ns;
   s.detected_ns = h.detected_ns;
+  s.realtime_offset_ns = h.realtime_offset_ns;
   s.frames = h.health.frames;
   s.camera_dropped = h.health.camera_dropped;
   s.queue_dropped = h.health.queue_dropped;
@@ -106,6 +107,7 @@ void from_sample(const mocap_node_BlobFrame& s, WireHeader& h) noexcept {
   h.trigger_received_ns = s.trigger_received_ns;
   h.sent_ns = s.sent_ns;
   h.detected_ns = s.detected_ns;
+  h.realtime_offset_ns = s.realtime_offset_ns;
   h.health = {s.frames, s.camera_dropped, s.queue_dropped, s.detect_overflow, s.timeouts};
   h.background_dn = s.background_dn;
   h.noise_dn = s.noise_dn;

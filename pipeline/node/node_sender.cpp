@@ -80,6 +80,7 @@ bool NodeSender::send_pending() noexcept {
       mocap_node_BlobFrame s{};
       to_sample(f->header, s);
       s.sent_ns = realtime_ns();
+      s.realtime_offset_ns = s.sent_ns - monotonic_ns();
       s.blobs._maximum = s.blobs._length =
           static_cast<std::uint32_t>(f->header.blob_count * kBlobRecordBytes);
       s.blobs._buffer = const_cast<std::uint8_t*>(f->blobs);  // DDS only reads it

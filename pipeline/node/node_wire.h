@@ -57,6 +57,9 @@ struct WireHeader {
   std::int64_t trigger_received_ns = 0;
   std::int64_t sent_ns = 0;
   std::int64_t detected_ns = 0;
+  // The node's CLOCK_REALTIME - CLOCK_MONOTONIC: the central maps a live camera's
+  // capture_ns onto its own clock through the (PTP-synchronised) CLOCK_REALTIME.
+  std::int64_t realtime_offset_ns = 0;
   WireHealth health;
   double background_dn = 0.0;
   double noise_dn = 0.0;
