@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cstdio>
 #include <thread>
+#include <utility>
 
 #include "core/clock.h"
 
@@ -186,6 +187,10 @@ void NodeLink::on_sample(const mocap_node_BlobFrame& s) noexcept {
   r.received_ns = now;
   estimate_offset(node, h, t3);
   if (h.sent_ns != 0) transit_.record(t3 - h.sent_ns);
+  if (h.trigger_sent_ns != 0 && h.trigger_received_ns != 0 && h.sent_ns != 0) {
+    trigger_leg_.record(h.trigger_received_ns - h.trigger_sent_ns);
+    node_work_.record(h.sent_ns - h.trigger_received_ns);
+  }
   if ((h.flags & kWireEndOfStream) == 0 &&
       h.frame_number + 1 > received_end_.load(std::memory_order_relaxed))  // single writer
     received_end_.store(h.frame_number + 1, std::memory_order_release);    // see received_end()
@@ -228,12 +233,18 @@ std::string NodeLink::report() const {
                   static_cast<double>(n->round_trip_ns.load(std::memory_order_relaxed)) / 1e3);
     out += line;
   }
-  const LatencyStats t = transit_.stats();
-  if (t.count > 0) {
-    char line[200];
+  // The legs of a frame's round trip, on CLOCK_REALTIME (meaningful when the clocks are
+  // one: a single host, or PTP).
+  const std::pair<const char*, const LatencyHistogram*> legs[] = {
+      {"trigger written -> node received", &trigger_leg_},
+      {"node trigger -> message written (replay/capture + detection)", &node_work_},
+      {"transit node sent -> central received", &transit_}};
+  for (const auto& [what, histogram] : legs) {
+    const LatencyStats t = histogram->stats();
+    if (t.count == 0) continue;
+    char line[256];
     std::snprintf(line, sizeof line,
-                  "nodes: transit node sent -> central received (CLOCK_REALTIME): %llu messages, "
-                  "p50 %.0f us, p99 %.0f us, max %.0f us\n",
+                  "nodes: %s: %llu messages, p50 %.0f us, p99 %.0f us, max %.0f us\n", what,
                   static_cast<unsigned long long>(t.count), t.p50_us, t.p99_us, t.max_us);
     out += line;
   }

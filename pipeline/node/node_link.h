@@ -114,6 +114,8 @@ class NodeLink {
   rt::RtThread receive_thread_, trigger_thread_;
   rt::Counter unknown_, triggers_sent_;
   LatencyHistogram transit_;
+  LatencyHistogram trigger_leg_;  // central trigger written -> node received it
+  LatencyHistogram node_work_;    // node received the trigger -> its message written
   std::string notice_;
 };
 
