@@ -52,7 +52,7 @@ std::string host_name() {
 }
 
 int run_node(const NodeArgs& a) {
-  if (a.config.empty()) return fail("mocap node: --config FILE is required");
+  if (a.config.empty()) return fail("--config: required (the node's configuration FILE)");
   if (a.duration_s < 0.0) return fail("--duration: must be >= 0");
   auto cfg = config::load_run_config(a.config, false, config::ConfigRole::kNode);
   if (!cfg) return fail(cfg.error().message);
