@@ -4,7 +4,6 @@
 #include <chrono>
 #include <cstdio>
 #include <thread>
-#include <utility>
 
 #include "core/clock.h"
 
@@ -231,21 +230,6 @@ std::string NodeLink::report() const {
                   static_cast<unsigned long long>(n->oversized.get()),
                   static_cast<double>(n->offset_ns.load(std::memory_order_relaxed)) / 1e3,
                   static_cast<double>(n->round_trip_ns.load(std::memory_order_relaxed)) / 1e3);
-    out += line;
-  }
-  // The legs of a frame's round trip, on CLOCK_REALTIME (meaningful when the clocks are
-  // one: a single host, or PTP).
-  const std::pair<const char*, const LatencyHistogram*> legs[] = {
-      {"trigger written -> node received", &trigger_leg_},
-      {"node trigger -> message written (replay/capture + detection)", &node_work_},
-      {"transit node sent -> central received", &transit_}};
-  for (const auto& [what, histogram] : legs) {
-    const LatencyStats t = histogram->stats();
-    if (t.count == 0) continue;
-    char line[256];
-    std::snprintf(line, sizeof line,
-                  "nodes: %s: %llu messages, p50 %.0f us, p99 %.0f us, max %.0f us\n", what,
-                  static_cast<unsigned long long>(t.count), t.p50_us, t.p99_us, t.max_us);
     out += line;
   }
   if (unknown_.get() > 0)

@@ -83,7 +83,11 @@ class NodeLink {
   }
   const std::vector<std::unique_ptr<NodeStats>>& nodes() const noexcept { return nodes_; }
   const LatencyHistogram& transit() const noexcept { return transit_; }  // node sent -> received
-  std::string report() const;  // one line per node (report time)
+  const LatencyHistogram& trigger_leg() const noexcept { return trigger_leg_; }
+  const LatencyHistogram& node_work() const noexcept { return node_work_; }
+  // One line per node: messages, malformed, oversized, clock offset (report time). The
+  // round-trip legs are in the run's statistics (LiveSetup::add_node_stats).
+  std::string report() const;
 
  private:
   NodeLink() = default;

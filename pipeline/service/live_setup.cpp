@@ -322,6 +322,39 @@ std::string LiveSetup::node_report() const {
   return out;
 }
 
+void LiveSetup::add_node_stats(pipeline::PipelineStats& st) const {
+#ifdef MOCAP_HAVE_NODES
+  if (!link_) return;
+  st.latency.emplace_back("node_trigger_leg", link_->trigger_leg().stats());
+  st.latency.emplace_back("node_work", link_->node_work().stats());
+  st.latency.emplace_back("node_transit", link_->transit().stats());
+  for (const auto& n : link_->nodes()) {
+    const std::string p = "node_" + n->name + "_";
+    st.counters.emplace_back(p + "messages", n->messages.get());
+    st.counters.emplace_back(p + "malformed", n->malformed.get());
+    st.counters.emplace_back(p + "oversized", n->oversized.get());
+    st.gauges.emplace_back(p + "clock_offset_us",
+                           static_cast<double>(n->offset_ns.load(std::memory_order_relaxed)) / 1e3);
+    st.gauges.emplace_back(
+        p + "round_trip_us",
+        static_cast<double>(n->round_trip_ns.load(std::memory_order_relaxed)) / 1e3);
+  }
+  st.counters.emplace_back("nodes_unknown_messages", link_->unknown());
+  for (std::size_t c = 0; c < cams_.size(); ++c) {
+    const auto* nc = dynamic_cast<const node::NodeCamera*>(cams_[c].get());
+    if (nc == nullptr) continue;
+    const std::string k = std::to_string(c);
+    st.counters.emplace_back("node_missing_cam" + k, nc->counters().missing.get());
+    st.counters.emplace_back("node_late_cam" + k, nc->late());
+    st.counters.emplace_back("node_duplicates_cam" + k, nc->duplicates());
+    st.counters.emplace_back("node_reconnects_cam" + k, nc->reconnects());
+    st.counters.emplace_back("node_inbox_full_cam" + k, nc->inbox_full());
+  }
+#else
+  (void)st;
+#endif
+}
+
 std::vector<std::string> LiveSetup::notices() const {
   std::vector<std::string> out;
   for (const auto& c : cams_) {

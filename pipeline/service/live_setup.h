@@ -98,6 +98,12 @@ class LiveSetup {
   // clock offset) and per node camera (missing, late, duplicates, reconnects); empty
   // without node cameras. Report time.
   std::string node_report() const;
+  // The same into the run's statistics (--stats): the round-trip legs as stages
+  // (node_trigger_leg, node_work, node_transit), counters per node (node_<name>_messages,
+  // _malformed, _oversized) and per node camera (node_missing_cam#, node_late_cam#,
+  // node_duplicates_cam#, node_reconnects_cam#, node_inbox_full_cam#), gauges
+  // node_<name>_clock_offset_us and node_<name>_round_trip_us. Nothing without nodes.
+  void add_node_stats(pipeline::PipelineStats& st) const;
 
  private:
   LiveSetup() = default;
