@@ -142,10 +142,12 @@ int run_node(const NodeArgs& a) {
   (*sender)->stop(true);  // the queued messages (the end of stream) reach the central
   if (ended) std::fprintf(stderr, "mocap node: the recording ended\n");
   std::fputs((*runner)->report().c_str(), stdout);
-  std::printf("sent %llu messages, %llu write errors, %llu central triggers received\n",
-              static_cast<unsigned long long>((*sender)->sent()),
-              static_cast<unsigned long long>((*sender)->write_errors()),
-              static_cast<unsigned long long>((*sender)->triggers_received()));
+  std::printf(
+      "sent %llu messages, %llu write errors, %llu central triggers received, %llu dropped\n",
+      static_cast<unsigned long long>((*sender)->sent()),
+      static_cast<unsigned long long>((*sender)->write_errors()),
+      static_cast<unsigned long long>((*sender)->triggers_received()),
+      static_cast<unsigned long long>((*sender)->triggers_dropped()));
   return 0;
 }
 #else
