@@ -75,6 +75,23 @@ void CaptureStage::wait_retired(std::uint64_t sequence, std::int64_t last_trigge
   }
 }
 
+bool CaptureStage::wait_first_frame(std::int64_t last_trigger_ns, std::uint64_t& last_sequence,
+                                    bool& end_of_stream) noexcept {
+  Doorbell& bell = context_.bell(StageId::kCapture);
+  const std::int64_t deadline = monotonic_ns() + kLockstepTimeoutNs;
+  while (!context_.stopping() && !end_of_stream && monotonic_ns() < deadline) {
+    const std::uint32_t seen = bell.snapshot();
+    bool pushed = false;
+    for (int c = 0; c < camera_count_; ++c)
+      pushed =
+          poll_camera(c, 0, true, last_trigger_ns, last_sequence, end_of_stream, false) || pushed;
+    if (pushed) return true;
+    bell.wait(seen, kLockstepPollNs);
+    release_returned();
+  }
+  return false;
+}
+
 void CaptureStage::run() noexcept {
   context_.loop_start(StageId::kCapture);
   const PipelineOptions& o = context_.options();
@@ -136,8 +153,13 @@ void CaptureStage::run() noexcept {
                            end_of_stream, true) ||
                pushed;
     }
-    if (pushed && triggered_mode && o.pacing == TriggerPacing::kLockstep)
-      wait_retired(last_sequence, last_trigger_ns, end_of_stream);
+    if (triggered_mode && o.pacing == TriggerPacing::kLockstep) {
+      // Lockstep: no trigger before this one's frames (slower than the period: camera
+      // nodes over a loaded network) arrived and were retired, each wait bounded.
+      if (!pushed && !end_of_stream)
+        pushed = wait_first_frame(last_trigger_ns, last_sequence, end_of_stream);
+      if (pushed) wait_retired(last_sequence, last_trigger_ns, end_of_stream);
+    }
   }
   context_.loop_end(StageId::kCapture);
 }

@@ -10,10 +10,10 @@
 // delivered) ends the triggering, as max_frames does. It owns no ring: each detect stage owns its
 // input and return rings; the capture holds their producer and consumer ends. run() is the hot
 // path: noexcept, allocation-free, lock-free, no logging; the only syscalls are the cameras'
-// trigger/dequeue/release and the trigger clock's sleep. Lockstep pacing waits for the last
-// trigger's frame to be retired while polling the cameras every millisecond, so a frame that
-// came after its camera's dequeue timed out (a camera node's round trip) still completes
-// its set.
+// trigger/dequeue/release and the trigger clock's sleep. Lockstep pacing waits (each wait
+// bounded by 1 s) for the last trigger's first frame and then for it to be retired, polling
+// the cameras every millisecond, so a frame that came after its camera's dequeue timed out
+// (a camera node's round trip) still completes its set and no trigger runs ahead of it.
 #pragma once
 
 #include <array>
@@ -71,6 +71,10 @@ class CaptureStage {
   // Lockstep: waits (bounded) until `sequence` was retired, polling the cameras meanwhile.
   void wait_retired(std::uint64_t sequence, std::int64_t last_trigger_ns,
                     bool& end_of_stream) noexcept;
+  // Lockstep, when no camera delivered within the trigger's dequeue pass: polls the
+  // cameras (bounded) until one delivers; true when a frame was pushed.
+  bool wait_first_frame(std::int64_t last_trigger_ns, std::uint64_t& last_sequence,
+                        bool& end_of_stream) noexcept;
   // Dequeues camera c (the first call waits up to timeout_ms) and hands its frames to its
   // detector; true when a frame was pushed. count_timeouts: an empty first dequeue counts
   // in dequeue_timeouts_cam# (not for the polls while lockstep waits).
