@@ -74,7 +74,9 @@ class NodeCluster : public ::testing::Test {
            ", realtime: false, lock_memory: false}\noutputs: {udp: [127.0.0.1:" +
            std::to_string(port) + "], iceoryx: false}\n";
   }
-  void write_cluster(int port, double rate_hz) {
+  // timeout_ms: how long the central waits for a node's frame before it is missing (the
+  // sanitizer builds' nodes take ~0.1-0.3 s per frame).
+  void write_cluster(int port, double rate_hz, int timeout_ms) {
     for (int n = 0; n < 2; ++n) {
       std::string y = "node: {name: n" + std::to_string(n) +
                       ", domain_id: " + std::to_string(domain_) +
@@ -85,7 +87,8 @@ class NodeCluster : public ::testing::Test {
       write("node" + std::to_string(n) + ".yaml", y);
     }
     std::string y = "node: {domain_id: " + std::to_string(domain_) +
-                    ", wait_s: 20}\nrig: " + recording() + "/rig.yaml\ncameras:\n";
+                    ", wait_s: 20, timeout_ms: " + std::to_string(timeout_ms) +
+                    "}\nrig: " + recording() + "/rig.yaml\ncameras:\n";
     for (int c = 0; c < 8; ++c)
       y += "  - {backend: node, device: n" + std::to_string(c / 4) + "/cam" + std::to_string(c) +
            "}\n";
@@ -111,7 +114,8 @@ class NodeCluster : public ::testing::Test {
     }
     cmd += "timeout 120 " + m + " run --config " + d + "/central.yaml --stats-interval 0 > " + d +
            "/central.log 2>&1; rc=$?; wait; [ -f " + d + "/node1b.pid ] && kill $(cat " + d +
-           "/node1b.pid); cat " + d + "/central.log " + d + "/node0.log; exit $rc";
+           "/node1b.pid); sleep 0.5; cat " + d + "/central.log " + d + "/node0.log; [ -f " + d +
+           "/node1b.log ] && cat " + d + "/node1b.log; exit $rc";
     return test::run_command(cmd);
   }
   std::string dir_;
@@ -131,7 +135,7 @@ TEST_F(NodeCluster, TwoNodesPublishEveryFrameWithTheSingleProcessAngles) {
   const Published ref = drain(single_sock);
   ASSERT_EQ(static_cast<int>(ref.angles.size()), kFrames) << one.output;
 
-  write_cluster(nodes_sock.port(), 100.0);
+  write_cluster(nodes_sock.port(), 100.0, 5000);  // no node dies: wait for every frame
   const test::RunResult r = run_cluster(0.0);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("the recording ended"), std::string::npos) << r.output;
@@ -158,26 +162,27 @@ TEST_F(NodeCluster, TwoNodesPublishEveryFrameWithTheSingleProcessAngles) {
 TEST_F(NodeCluster, AKilledNodesCamerasGoMissingComeBackAndTheRunEndsNormally) {
   test::KeepAllUdpSocket sock(300'000);
   ASSERT_TRUE(sock.ok());
-  write_cluster(sock.port(), 10.0);  // 10 Hz: the kill and the restart land mid-run
+  write_cluster(sock.port(), 10.0, 500);  // 10 Hz: the kill and the restart land mid-run
   const test::RunResult r = run_cluster(0.3 * kFrames / 10.0 + 0.5, 0.3);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("the recording ended"), std::string::npos) << r.output;
   const Published got = drain(sock);
   // Frames after the kill are published from node n0's cameras alone.
   EXPECT_GE(got.datagrams, kFrames / 2) << r.output;
-  EXPECT_NE(r.output.find("node:n1/cam4: frames"), std::string::npos) << r.output;
-  EXPECT_EQ(r.output.find("node:n1/cam4: frames " + std::to_string(kFrames) + ","),
-            std::string::npos)
-      << "node n1 was not killed mid-run\n"
-      << r.output;
+  // The kill made node n1's cameras miss frames (the set went on without them)...
   const std::size_t at = r.output.find("node:n1/cam4: frames");
+  ASSERT_NE(at, std::string::npos) << r.output;
   const std::size_t missing = r.output.find("missing ", at);
   ASSERT_NE(missing, std::string::npos) << r.output;
   EXPECT_GT(std::stol(r.output.substr(missing + 8)), 0) << r.output;
-  // The node came back (a new process) and its cameras were used again.
-  const std::size_t reconnects = r.output.find("reconnects ", at);
-  ASSERT_NE(reconnects, std::string::npos) << r.output;
-  EXPECT_GT(std::stol(r.output.substr(reconnects + 11)), 0) << r.output;
+  // ... and the node came back (a new process: its report "camera cam4: ...") and the
+  // central took its frames (all but a few that may have come late).
+  const std::size_t again = r.output.find("camera cam4: frames ");
+  ASSERT_NE(again, std::string::npos) << "node n1 was not restarted\n" << r.output;
+  const long sent_again = std::stol(r.output.substr(again + 20));
+  EXPECT_GT(sent_again, 0) << r.output;
+  const long central_frames = std::stol(r.output.substr(at + 21));
+  EXPECT_GT(central_frames, sent_again - 3) << r.output;  // a few may come late
 }
 
 }  // namespace
