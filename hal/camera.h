@@ -28,6 +28,10 @@
 #include "core/image.h"
 #include "rt/counter.h"
 
+namespace mocap::detect {
+class BlobList;
+}
+
 namespace mocap::hal {
 
 using mocap::TriggerMode;  // core/capture_modes.h
@@ -82,6 +86,9 @@ struct Frame {
                                    // 0: timestamp_ns is local (live cameras)
   std::uint32_t buffer_index = 0;  // backend buffer; used by release()
   bool missing = false;            // replay: this camera has no image for this frame
+  // A camera node's frame (pipeline/node/node_camera.h): the blobs its node detected,
+  // owned by the camera until release(); no image. The detect stage passes them through.
+  const detect::BlobList* blobs = nullptr;
 };
 
 // The local CLOCK_MONOTONIC instant a frame's latencies are measured from: the exposure/

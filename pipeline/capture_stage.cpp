@@ -53,20 +53,43 @@ void CaptureStage::setup_clock_checks(bool triggered_mode, std::int64_t period_n
 
 void CaptureStage::finish_triggering() noexcept {
   if (context_.triggering_done()) return;
-  end_sequence_.store(delivered_end_, std::memory_order_relaxed);
+  end_sequence_.store(std::min(delivered_end_, ended_end_), std::memory_order_relaxed);
   context_.set_triggering_done();  // release: publishes end_sequence_ too
 }
 
-void CaptureStage::wait_retired(std::uint64_t sequence) noexcept {
+void CaptureStage::wait_retired(std::uint64_t sequence, std::int64_t last_trigger_ns,
+                                bool& end_of_stream) noexcept {
   Doorbell& bell = context_.bell(StageId::kCapture);
   const std::int64_t deadline = monotonic_ns() + kLockstepTimeoutNs;
   while (!context_.stopping() && context_.retired_plus_one() <= sequence &&
          monotonic_ns() < deadline) {
     const std::uint32_t seen = bell.snapshot();
     if (context_.retired_plus_one() > sequence) break;
-    bell.wait(seen, kIdleWaitNs);
+    // Frames of this trigger that came after their camera's dequeue timed out (a slow
+    // camera, a camera node's round trip): take them now, or the set never completes.
+    std::uint64_t last = 0;
+    for (int c = 0; c < camera_count_; ++c)
+      (void)poll_camera(c, 0, true, last_trigger_ns, last, end_of_stream, false);
+    bell.wait(seen, kLockstepPollNs);
     release_returned();
   }
+}
+
+bool CaptureStage::wait_first_frame(std::int64_t last_trigger_ns, std::uint64_t& last_sequence,
+                                    bool& end_of_stream) noexcept {
+  Doorbell& bell = context_.bell(StageId::kCapture);
+  const std::int64_t deadline = monotonic_ns() + kLockstepTimeoutNs;
+  while (!context_.stopping() && !end_of_stream && monotonic_ns() < deadline) {
+    const std::uint32_t seen = bell.snapshot();
+    bool pushed = false;
+    for (int c = 0; c < camera_count_; ++c)
+      pushed =
+          poll_camera(c, 0, true, last_trigger_ns, last_sequence, end_of_stream, false) || pushed;
+    if (pushed) return true;
+    bell.wait(seen, kLockstepPollNs);
+    release_returned();
+  }
+  return false;
 }
 
 void CaptureStage::run() noexcept {
@@ -120,48 +143,68 @@ void CaptureStage::run() noexcept {
     std::uint64_t last_sequence = 0;
     bool pushed = false;
     for (int c = 0; c < camera_count_; ++c) {
-      const auto ci = static_cast<std::size_t>(c);
-      hal::Camera& cam = *cameras_[ci];
       int timeout_ms = 5;  // free-run: the cameras are polled in turn
       if (triggered_mode) {
         const std::int64_t left_ns = next_trigger_ns - monotonic_ns();
         const std::int64_t left_ms = (left_ns + 999'999) / 1'000'000;  // round up
         timeout_ms = static_cast<int>(std::clamp<std::int64_t>(left_ms, 0, o.dequeue_timeout_ms));
       }
-      const int max_frames = cam.config().buffer_count;
-      for (int n = 0; n < max_frames; ++n) {
-        hal::Frame f;
-        const hal::CameraStatus st = cam.dequeue(f, n == 0 ? timeout_ms : 0);
-        if (st == hal::CameraStatus::kTimeout || st == hal::CameraStatus::kAgain) {
-          if (n == 0) k.dequeue_timeouts[ci].add();
-          break;
-        }
-        if (st == hal::CameraStatus::kEndOfStream) {
-          if (!triggered_mode) finish_triggering();
-          end_of_stream = true;
-          break;
-        }
-        if (st != hal::CameraStatus::kOk) {
-          k.dequeue_errors.add();
-          break;
-        }
-        on_frame_received(c, f, last_trigger_ns);
-        if (o.tap != nullptr) o.tap->on_frame(c, f);
-        if (!triggered_mode && c == 0) k.triggered.add();
-        last_sequence = f.sequence;
-        if (detect_[ci]->input().try_push(f)) {
-          pushed = true;
-          context_.bell(StageId::detect(c)).ring();
-        } else {  // the detector holds every slot (stalled): drop this frame
-          k.ring_full[ci].add();
-          if (cam.release(f) != hal::CameraStatus::kOk) k.release_errors.add();
-        }
-      }
+      pushed = poll_camera(c, timeout_ms, triggered_mode, last_trigger_ns, last_sequence,
+                           end_of_stream, true) ||
+               pushed;
     }
-    if (pushed && triggered_mode && o.pacing == TriggerPacing::kLockstep)
-      wait_retired(last_sequence);
+    if (triggered_mode && o.pacing == TriggerPacing::kLockstep) {
+      // Lockstep: no trigger before this one's frames (slower than the period: camera
+      // nodes over a loaded network) arrived and were retired, each wait bounded.
+      if (!pushed && !end_of_stream)
+        pushed = wait_first_frame(last_trigger_ns, last_sequence, end_of_stream);
+      if (pushed) wait_retired(last_sequence, last_trigger_ns, end_of_stream);
+    }
   }
   context_.loop_end(StageId::kCapture);
+}
+
+bool CaptureStage::poll_camera(int c, int timeout_ms, bool triggered_mode,
+                               std::int64_t last_trigger_ns, std::uint64_t& last_sequence,
+                               bool& end_of_stream, bool count_timeouts) noexcept {
+  Counters& k = counters_;
+  const auto ci = static_cast<std::size_t>(c);
+  hal::Camera& cam = *cameras_[ci];
+  bool pushed = false;
+  const int max_frames = cam.config().buffer_count;
+  for (int n = 0; n < max_frames; ++n) {
+    hal::Frame f;
+    const hal::CameraStatus st = cam.dequeue(f, n == 0 ? timeout_ms : 0);
+    if (st == hal::CameraStatus::kTimeout || st == hal::CameraStatus::kAgain) {
+      if (n == 0 && count_timeouts) k.dequeue_timeouts[ci].add();
+      break;
+    }
+    if (st == hal::CameraStatus::kEndOfStream) {
+      // No set can complete from this camera's last frame on (cameras of different
+      // lengths: a camera node whose replay restarted).
+      ended_end_ = std::min(ended_end_, camera_end_[ci]);
+      if (!triggered_mode) finish_triggering();
+      end_of_stream = true;
+      break;
+    }
+    if (st != hal::CameraStatus::kOk) {
+      k.dequeue_errors.add();
+      break;
+    }
+    on_frame_received(c, f, last_trigger_ns);
+    const PipelineOptions& o = context_.options();
+    if (o.tap != nullptr) o.tap->on_frame(c, f);
+    if (!triggered_mode && c == 0) k.triggered.add();
+    last_sequence = f.sequence;
+    if (detect_[ci]->input().try_push(f)) {
+      pushed = true;
+      context_.bell(StageId::detect(c)).ring();
+    } else {  // the detector holds every slot (stalled): drop this frame
+      k.ring_full[ci].add();
+      if (cam.release(f) != hal::CameraStatus::kOk) k.release_errors.add();
+    }
+  }
+  return pushed;
 }
 
 void CaptureStage::on_frame_received(int camera, const hal::Frame& frame,
@@ -188,6 +231,7 @@ void CaptureStage::on_frame_received(int camera, const hal::Frame& frame,
              static_cast<std::uint64_t>(std::max<std::int64_t>(now - last, 0) / 1000));
   context_.note_first_sequence(frame.sequence);
   delivered_end_ = std::max(delivered_end_, frame.sequence + 1);
+  camera_end_[c] = std::max(camera_end_[c], frame.sequence + 1);
 }
 
 void CaptureStage::report(rt::CounterReport& out) const {

@@ -10,7 +10,10 @@
 // delivered) ends the triggering, as max_frames does. It owns no ring: each detect stage owns its
 // input and return rings; the capture holds their producer and consumer ends. run() is the hot
 // path: noexcept, allocation-free, lock-free, no logging; the only syscalls are the cameras'
-// trigger/dequeue/release and the trigger clock's sleep.
+// trigger/dequeue/release and the trigger clock's sleep. Lockstep pacing waits (each wait
+// bounded by 1 s) for the last trigger's first frame and then for it to be retired, polling
+// the cameras every millisecond, so a frame that came after its camera's dequeue timed out
+// (a camera node's round trip) still completes its set and no trigger runs ahead of it.
 #pragma once
 
 #include <array>
@@ -39,7 +42,8 @@ class CaptureStage {
   // Any thread.
   std::uint64_t triggered() const noexcept { return counters_.triggered.get(); }
   // Once the triggering is done (StageContext::triggering_done()): the highest sequence
-  // the cameras delivered + 1, the sequence the pipeline must retire to be finished
+  // the cameras delivered + 1 (at most the end of the first camera whose stream ended:
+  // later sequences can never form a set), the sequence the pipeline must retire to be finished
   // (sequences are the cameras' own: a replay's start at its recording's first frame).
   std::uint64_t end_sequence() const noexcept {
     // relaxed: read after StageContext::triggering_done() (acquire), which it precedes.
@@ -64,10 +68,21 @@ class CaptureStage {
   // trigger_ns: host time of the last software trigger (0: free-running cameras).
   void on_frame_received(int camera, const hal::Frame& frame, std::int64_t trigger_ns) noexcept;
   void setup_clock_checks(bool triggered_mode, std::int64_t period_ns) noexcept;
-  // Lockstep: waits (bounded) until `sequence` was retired.
-  void wait_retired(std::uint64_t sequence) noexcept;
+  // Lockstep: waits (bounded) until `sequence` was retired, polling the cameras meanwhile.
+  void wait_retired(std::uint64_t sequence, std::int64_t last_trigger_ns,
+                    bool& end_of_stream) noexcept;
+  // Lockstep, when no camera delivered within the trigger's dequeue pass: polls the
+  // cameras (bounded) until one delivers; true when a frame was pushed.
+  bool wait_first_frame(std::int64_t last_trigger_ns, std::uint64_t& last_sequence,
+                        bool& end_of_stream) noexcept;
+  // Dequeues camera c (the first call waits up to timeout_ms) and hands its frames to its
+  // detector; true when a frame was pushed. count_timeouts: an empty first dequeue counts
+  // in dequeue_timeouts_cam# (not for the polls while lockstep waits).
+  bool poll_camera(int c, int timeout_ms, bool triggered_mode, std::int64_t last_trigger_ns,
+                   std::uint64_t& last_sequence, bool& end_of_stream, bool count_timeouts) noexcept;
 
   static constexpr std::int64_t kLockstepTimeoutNs = 1'000'000'000;
+  static constexpr std::int64_t kLockstepPollNs = 1'000'000;  // cameras polled while waiting
 
   StageContext& context_;
   const std::vector<hal::Camera*> cameras_;
@@ -77,7 +92,10 @@ class CaptureStage {
   std::array<TimestampCheck, kMaxCameras> clock_checks_{};  // this thread (set in run())
   std::array<std::atomic<std::int64_t>, kMaxCameras> last_frame_ns_{};  // this thread writes
   void finish_triggering() noexcept;
-  std::uint64_t delivered_end_ = 0;             // highest sequence dequeued + 1 (this thread)
+  std::uint64_t delivered_end_ = 0;  // highest sequence dequeued + 1 (this thread)
+  std::array<std::uint64_t, kMaxCameras> camera_end_{};  // the same per camera (this thread)
+  // The lowest camera_end_ of the cameras that reached their end of stream (this thread).
+  std::uint64_t ended_end_ = ~std::uint64_t{0};
   std::atomic<std::uint64_t> end_sequence_{0};  // delivered_end_ when the triggering ended
 
   struct alignas(64) Counters {

@@ -67,8 +67,12 @@ void DetectStage::run() noexcept {
     const std::int64_t t0 = monotonic_ns();
     BlobSlot& slot = out_[h];
     slot.blobs.clear();
-    slot.present = !f.missing && !f.image.empty();
-    if (slot.present) {
+    slot.present = !f.missing && (!f.image.empty() || f.blobs != nullptr);
+    if (slot.present && f.blobs != nullptr) {  // a camera node detected them: pass through
+      for (const detect::Blob& b : *f.blobs) slot.blobs.push_back(b);  // capacity: counted
+      slot.blobs.set_levels(f.blobs->levels());
+      library_.blobs.add(slot.blobs.size());
+    } else if (slot.present) {
       processor_.detect_camera(camera_, f.image, slot.blobs);
       library_.blobs.add(slot.blobs.size());
       library_.detector.publish(kDetectorFields, processor_.detector_counters(camera_));

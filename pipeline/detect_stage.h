@@ -5,6 +5,8 @@
 // so it never fills). It fills blob slots of the identify stage's pool for its camera.
 //   input ring --newest frame--> FrameProcessor::detect_camera --> blob slot (identify)
 //        ^-- older frames (skipped) and the detected frame go back on the return ring
+// A camera node's frame (hal::Frame::blobs, pipeline/node/node_camera.h) carries the blobs
+// its node detected and no image: they are copied into the blob slot, not detected.
 // Drop policy: it works on the NEWEST frame and returns the older ones (detect#_skipped);
 // when identify holds every blob slot the frame is dropped (detect#_no_slot). With
 // options.detect_every_frame (`mocap record --blobs`) it detects every frame in order

@@ -63,6 +63,8 @@ struct PipelineStats {
   // ("publish" is trigger-to-publish, end to end); *_work are the stage's own times.
   std::vector<std::pair<std::string, LatencyStats>> latency;
   std::vector<std::pair<std::string, std::uint64_t>> counters;
+  // Signed or fractional values (camera nodes' clock offsets); JSON "gauges", when any.
+  std::vector<std::pair<std::string, double>> gauges;
 };
 
 class Pipeline final : public HealthSource {

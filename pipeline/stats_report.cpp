@@ -131,6 +131,14 @@ std::string pipeline_stats_json(const PipelineStats& s) {
                   static_cast<unsigned long long>(s.counters[i].second));
     out += buf;
   }
+  if (!s.gauges.empty()) {
+    out += "\n  },\n  \"gauges\": {";
+    for (std::size_t i = 0; i < s.gauges.size(); ++i) {
+      std::snprintf(buf, sizeof buf, "%s\n    \"%s\": %.3f", i == 0 ? "" : ",",
+                    s.gauges[i].first.c_str(), s.gauges[i].second);
+      out += buf;
+    }
+  }
   out += "\n  },\n  \"coverage\": {";
   const std::vector<JointCoverage> cov = coverage_of(s);
   for (std::size_t i = 0; i < cov.size(); ++i) {

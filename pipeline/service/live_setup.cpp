@@ -12,6 +12,9 @@
 #ifdef MOCAP_HAVE_LIBCAMERA
 #include "hal/libcamera_camera.h"
 #endif
+#ifdef MOCAP_HAVE_NODES
+#include "pipeline/node/node_camera.h"
+#endif
 
 namespace mocap::service {
 
@@ -125,6 +128,9 @@ pipeline::PipelineOptions pipeline_options(const config::RunConfig& cfg) {
   o.lock_memory = cfg.pipeline.lock_memory;
   o.cpu_latency_us = cfg.pipeline.cpu_latency_us;
   o.dequeue_timeout_ms = cfg.pipeline.dequeue_timeout_ms;
+  o.pair_by = cfg.pipeline.pair_by == config::PairBy::kTimestamp ? pipeline::PairBy::kTimestamp
+                                                                 : pipeline::PairBy::kSequence;
+  o.pair_tolerance_us = cfg.pipeline.pair_tolerance_us;
   for (std::size_t i = 0; i < config::kStageCount; ++i) {
     const config::StageSettings& s = cfg.pipeline.stages[i];
     pipeline::StageSpec& d = o.stages.rows[i];
@@ -167,6 +173,8 @@ bool replay_has_master(const config::RunConfig& cfg) {
     if (c.trigger && *c.trigger == hal::TriggerMode::kSoftware) return true;
   return false;
 }
+
+std::string index_name(std::size_t c) { return "cameras[" + std::to_string(c) + "]"; }
 
 void say(std::FILE* log, const std::string& line, const char* command = "mocap run") {
   if (log != nullptr) std::fprintf(log, "%s: %s\n", command, line.c_str());
@@ -216,11 +224,36 @@ Expected<std::unique_ptr<LiveSetup>> LiveSetup::create(const config::RunConfig& 
                             std::to_string(s->recording_->rig().cameras.size()));
     }
     for (int c = 0; c < static_cast<int>(n); ++c) {
-      auto cam = hal::ReplayCamera::open(s->recording_, c, hal::ReplayPacing::kRecordedTiming);
+      auto index = replay_camera_index(*s->recording_, cfg.cameras[static_cast<std::size_t>(c)], c,
+                                       cfg.path.empty() ? std::string(command) : cfg.path);
+      if (!index) return index.error();
+      auto cam = hal::ReplayCamera::open(s->recording_, *index, hal::ReplayPacing::kRecordedTiming);
       if (!cam) return cam.error();
       native[static_cast<std::size_t>(c)] = (*cam)->native_config();
       cams[static_cast<std::size_t>(c)] = std::move(cam).value();
     }
+  } else if (backend == CameraBackend::kNode) {
+    assets = config::load_tracking_assets(cfg, nullptr, nullptr, nullptr, targets_required);
+    if (!assets) return assets.error();
+#ifdef MOCAP_HAVE_NODES
+    auto link = node::NodeLink::create(cfg.node.domain_id, cfg.node.wait_s);
+    if (!link) return link.error();
+    s->link_ = std::move(link).value();
+    for (std::size_t c = 0; c < n; ++c) {
+      auto cam = node::NodeCamera::open(s->link_, cfg.cameras[c].device,
+                                        cfg.tracker.detect.max_blobs, cfg.node.timeout_ms);
+      if (!cam) return make_error(cfg.path, index_name(c), cam.error().message);
+      native[c] = (*cam)->native_config();
+      cams[c] = std::move(cam).value();
+    }
+    say(log,
+        "camera nodes: DDS domain " + std::to_string(cfg.node.domain_id) + ", " +
+            std::to_string(n) + " cameras",
+        command);
+#else
+    return make_error(cfg.path, "cameras[0].backend",
+                      "camera nodes are not built in (Cyclone DDS missing at build time)");
+#endif
   } else {
     assets = config::load_tracking_assets(cfg, nullptr, nullptr, nullptr, targets_required);
     if (!assets) return assets.error();
@@ -297,6 +330,71 @@ Expected<std::unique_ptr<LiveSetup>> LiveSetup::create(const config::RunConfig& 
   s->processor_.emplace(std::move(proc).value());
   s->assets_ = std::move(assets).value();
   return s;
+}
+
+Expected<int> replay_camera_index(const Recording& recording, const config::CameraSettings& s,
+                                  int position, const std::string& where) {
+  const auto& cams = recording.rig().cameras;
+  if (s.recording_camera.empty()) return position;
+  std::string names;
+  for (std::size_t i = 0; i < cams.size(); ++i) {
+    if (cams[i].name == s.recording_camera) return static_cast<int>(i);
+    names += (i ? ", " : "") + cams[i].name;
+  }
+  return make_error(
+      where, "cameras[" + std::to_string(position) + "].camera",
+      "the recording has no camera '" + s.recording_camera + "' (it has " + names + ")");
+}
+
+std::string LiveSetup::node_report() const {
+  std::string out;
+#ifdef MOCAP_HAVE_NODES
+  if (!link_) return out;
+  out += link_->report();
+  for (const auto& c : cams_) {
+    const auto* nc = dynamic_cast<const node::NodeCamera*>(c.get());
+    if (nc == nullptr) continue;
+    out += nc->name() + ": frames " + std::to_string(nc->counters().frames.get()) + ", missing " +
+           std::to_string(nc->counters().missing.get()) + ", late " + std::to_string(nc->late()) +
+           ", duplicates " + std::to_string(nc->duplicates()) + ", reconnects " +
+           std::to_string(nc->reconnects()) + ", inbox_full " + std::to_string(nc->inbox_full()) +
+           "\n";
+  }
+#endif
+  return out;
+}
+
+void LiveSetup::add_node_stats(pipeline::PipelineStats& st) const {
+#ifdef MOCAP_HAVE_NODES
+  if (!link_) return;
+  st.latency.emplace_back("node_trigger_leg", link_->trigger_leg().stats());
+  st.latency.emplace_back("node_work", link_->node_work().stats());
+  st.latency.emplace_back("node_transit", link_->transit().stats());
+  for (const auto& n : link_->nodes()) {
+    const std::string p = "node_" + n->name + "_";
+    st.counters.emplace_back(p + "messages", n->messages.get());
+    st.counters.emplace_back(p + "malformed", n->malformed.get());
+    st.counters.emplace_back(p + "oversized", n->oversized.get());
+    st.gauges.emplace_back(p + "clock_offset_us",
+                           static_cast<double>(n->offset_ns.load(std::memory_order_relaxed)) / 1e3);
+    st.gauges.emplace_back(
+        p + "round_trip_us",
+        static_cast<double>(n->round_trip_ns.load(std::memory_order_relaxed)) / 1e3);
+  }
+  st.counters.emplace_back("nodes_unknown_messages", link_->unknown());
+  for (std::size_t c = 0; c < cams_.size(); ++c) {
+    const auto* nc = dynamic_cast<const node::NodeCamera*>(cams_[c].get());
+    if (nc == nullptr) continue;
+    const std::string k = std::to_string(c);
+    st.counters.emplace_back("node_missing_cam" + k, nc->counters().missing.get());
+    st.counters.emplace_back("node_late_cam" + k, nc->late());
+    st.counters.emplace_back("node_duplicates_cam" + k, nc->duplicates());
+    st.counters.emplace_back("node_reconnects_cam" + k, nc->reconnects());
+    st.counters.emplace_back("node_inbox_full_cam" + k, nc->inbox_full());
+  }
+#else
+  (void)st;
+#endif
 }
 
 std::vector<std::string> LiveSetup::notices() const {

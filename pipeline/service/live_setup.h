@@ -24,7 +24,16 @@
 #include "pipeline/publish/output_registry.h"
 #include "track/frame_processor.h"
 
+namespace mocap::node {
+class NodeLink;
+}
+
 namespace mocap::service {
+
+// Replay camera `position` of the configuration: the recording's camera named by
+// `camera: NAME` (settings.recording_camera), else the same position; one-line error.
+Expected<int> replay_camera_index(const Recording& recording, const config::CameraSettings& s,
+                                  int position, const std::string& where);
 
 // Command-line flags that override the configuration file (`mocap run`, `record`,
 // `preview`: src/app/config_flags.h). Unset: the configuration's value. No default and no
@@ -85,12 +94,23 @@ class LiveSetup {
   const config::TrackingAssets& assets() const noexcept { return assets_; }
   // One line per camera fallback (hal::Camera::notice), empty entries left out.
   std::vector<std::string> notices() const;
+  // Camera nodes (backend node): one line per node (messages, malformed, oversized,
+  // clock offset) and per node camera (missing, late, duplicates, reconnects); empty
+  // without node cameras. Report time.
+  std::string node_report() const;
+  // The same into the run's statistics (--stats): the round-trip legs as stages
+  // (node_trigger_leg, node_work, node_transit), counters per node (node_<name>_messages,
+  // _malformed, _oversized) and per node camera (node_missing_cam#, node_late_cam#,
+  // node_duplicates_cam#, node_reconnects_cam#, node_inbox_full_cam#), gauges
+  // node_<name>_clock_offset_us and node_<name>_round_trip_us. Nothing without nodes.
+  void add_node_stats(pipeline::PipelineStats& st) const;
 
  private:
   LiveSetup() = default;
   std::shared_ptr<const hal::SimFrameLoop> loop_;
   std::shared_ptr<hal::SimTrigger> trigger_;
   std::shared_ptr<const Recording> recording_;
+  std::shared_ptr<node::NodeLink> link_;  // backend node (pipeline/node/node_link.h)
   std::vector<std::unique_ptr<hal::Camera>> cams_;
   std::optional<FrameProcessor> processor_;
   config::TrackingAssets assets_;

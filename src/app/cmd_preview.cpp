@@ -101,6 +101,10 @@ int preview(const PreviewArgs& a) {
   cli.no_iceoryx = true;
   auto cfg = service::resolve_run_config(a.config, cli, false);
   if (!cfg) return fail(cfg.error().message);
+  if (cfg->cameras[0].backend == config::CameraBackend::kNode)
+    return fail(cfg->path +
+                ": cameras[0].backend: node: this command needs images; camera nodes send blobs "
+                "(run `mocap preview` on the node PC with its cameras)");
   std::error_code ec;
   std::filesystem::create_directories(a.out, ec);
   if (ec || !std::filesystem::is_directory(a.out, ec))

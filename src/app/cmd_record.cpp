@@ -121,6 +121,10 @@ int record(const RecordArgs& a) {
   cli.no_iceoryx = true;
   auto cfg = service::resolve_run_config(a.config, cli, false);
   if (!cfg) return fail(cfg.error().message);
+  if (cfg->cameras[0].backend == config::CameraBackend::kNode)
+    return fail(cfg->path +
+                ": cameras[0].backend: node: mocap record writes images and node cameras send blob "
+                "lists (blob recordings, `mocap record --blobs`, are not in this build)");
   if (auto r = record::prepare_output_dir(a.out); !r) return fail(r.error().message);
   std::signal(SIGINT, on_record_signal);
   std::signal(SIGTERM, on_record_signal);

@@ -194,8 +194,10 @@ int run_live(const RunArgs& a) {
   supervise(**pipe, a, service);
   service.stopping();
   (*pipe)->stop();
-  const pipeline::PipelineStats st = (*pipe)->stats();
+  pipeline::PipelineStats st = (*pipe)->stats();
+  (*live)->add_node_stats(st);  // camera nodes: legs, counters, clock offsets
   std::fputs(pipeline::format_pipeline_stats(st).c_str(), stdout);
+  std::fputs((*live)->node_report().c_str(), stdout);  // camera nodes: empty without
   report_camera_faults((*pipe)->health());
   if (!a.stats.empty()) {
     if (auto r = pipeline::write_pipeline_stats_json(a.stats, st); !r)

@@ -59,6 +59,23 @@ class Section {
   std::string where_;
 };
 
+}  // namespace mocap::config_detail
+
+namespace mocap::config {
+struct CameraSettings;
+struct NodeSettings;
+struct PipelineSettings;
+}  // namespace mocap::config
+
+namespace mocap::config_detail {
+
+// The camera-node keys (run_config_nodes.cpp): a camera's `trigger` (free_run | external |
+// software | central), replay `camera: NAME`; the `node:` section; pipeline.pair_by and
+// pair_tolerance_us.
+void read_node_camera_keys(const Section& s, config::CameraSettings& cam);
+void read_node_section(const YAML::Node& node, config::NodeSettings& n);
+void read_pair_keys(const Section& s, config::PipelineSettings& p);
+
 // Empty when `value` is a valid HOST:PORT, else the problem (run_config_checks.cpp).
 std::string host_port_problem(const std::string& value);
 

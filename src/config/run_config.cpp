@@ -57,21 +57,25 @@ void read_camera(const YAML::Node& node, const std::string& where, const std::st
                  CameraSettings& cam) {
   const Section s(node, where,
                   {"backend", "device", "format", "width", "height", "exposure_us", "gain",
-                   "trigger", "frame_rate_hz", "buffers"});
+                   "trigger", "frame_rate_hz", "buffers", "camera"});
   if (!s.has("backend")) fail(s.path("backend"), "missing key" + line_suffix(node));
   cam.backend = *s.choice<CameraBackend>("backend", {{"sim", CameraBackend::kSim},
                                                      {"replay", CameraBackend::kReplay},
                                                      {"v4l2", CameraBackend::kV4l2},
-                                                     {"libcamera", CameraBackend::kLibcamera}});
+                                                     {"libcamera", CameraBackend::kLibcamera},
+                                                     {"node", CameraBackend::kNode}});
   const char* backend = to_string(cam.backend);
   const bool native = cam.backend == CameraBackend::kSim || cam.backend == CameraBackend::kReplay;
   if (const auto d = s.text("device")) {
     if (cam.backend == CameraBackend::kSim) s.bad("device", "not used by the sim backend");
-    cam.device = cam.backend == CameraBackend::kLibcamera ? *d : resolve(dir, *d);
+    const bool named =
+        cam.backend == CameraBackend::kLibcamera || cam.backend == CameraBackend::kNode;
+    cam.device = named ? *d : resolve(dir, *d);
   } else if (cam.backend != CameraBackend::kSim) {
     fail(s.path("device"), std::string("missing key (the ") + backend + " backend needs " +
                                (cam.backend == CameraBackend::kReplay ? "the recording folder"
                                 : cam.backend == CameraBackend::kV4l2 ? "the device node"
+                                : cam.backend == CameraBackend::kNode ? "NODE/CAMERA"
                                                                       : "a camera id or index") +
                                ")" + line_suffix(node));
   }
@@ -90,26 +94,28 @@ void read_camera(const YAML::Node& node, const std::string& where, const std::st
   if (const auto v = s.integer("exposure_us", 1, 10'000'000))
     cam.exposure_us = static_cast<int>(*v);
   if (const auto v = s.number("gain", 0.0, 1e6)) cam.gain = *v;
-  cam.trigger = s.choice<TriggerMode>("trigger", {{"free_run", TriggerMode::kFreeRun},
-                                                  {"external", TriggerMode::kExternal},
-                                                  {"software", TriggerMode::kSoftware}});
+  config_detail::read_node_camera_keys(s, cam);  // trigger (+ central), camera, node device
   cam.frame_rate_hz = positive(s, "frame_rate_hz", 10000.0);
   if (const auto v = s.integer("buffers", 2, 64)) cam.buffers = static_cast<int>(*v);
 }
 
-void read_cameras(const YAML::Node& node, const std::string& dir, RunConfig& cfg) {
+void read_cameras(const YAML::Node& node, const std::string& dir, RunConfig& cfg, ConfigRole role) {
   formats_detail::require_list(node, "cameras");
   const std::size_t n = node.size();
-  if (n < static_cast<std::size_t>(kMinCameras) || n > static_cast<std::size_t>(kMaxCameras)) {
-    fail("cameras",
-         std::to_string(n) + (n == 1 ? " camera, " : " cameras, ") +
-             (n < static_cast<std::size_t>(kMinCameras) ? "at least " : "at most ") +
-             std::to_string(n < static_cast<std::size_t>(kMinCameras) ? kMinCameras : kMaxCameras) +
-             line_suffix(node));
+  const std::size_t lo = role == ConfigRole::kNode ? 1 : static_cast<std::size_t>(kMinCameras);
+  const auto hi = static_cast<std::size_t>(kMaxCameras);  // a node: at most 8 as well
+  if (n < lo || n > hi) {
+    fail("cameras", std::to_string(n) + (n == 1 ? " camera, " : " cameras, ") +
+                        (n < lo ? "at least " : "at most ") + std::to_string(n < lo ? lo : hi) +
+                        line_suffix(node));
   }
   cfg.cameras.assign(n, CameraSettings{});
-  for (std::size_t c = 0; c < n; ++c)
+  for (std::size_t c = 0; c < n; ++c) {
     read_camera(node[c], index_path("cameras", c), dir, cfg.cameras[c]);
+    if (cfg.cameras[c].central_trigger && role != ConfigRole::kNode)
+      fail(index_path("cameras", c) + ".trigger",
+           "'central' is for the cameras of a `mocap node`" + line_suffix(node[c]));
+  }
   const CameraSettings& a = cfg.cameras[0];
   for (std::size_t c = 1; c < n; ++c) {
     const CameraSettings& b = cfg.cameras[c];
@@ -135,7 +141,8 @@ void read_cameras(const YAML::Node& node, const std::string& dir, RunConfig& cfg
 void read_pipeline(const YAML::Node& node, PipelineSettings& p) {
   const Section s(node, "pipeline",
                   {"trigger_rate_hz", "pacing", "realtime", "lock_memory", "cpu_latency_us",
-                   "dequeue_timeout_ms", "stages"});
+                   "dequeue_timeout_ms", "stages", "pair_by", "pair_tolerance_us"});
+  config_detail::read_pair_keys(s, p);
   set(p.trigger_rate_hz, s.number("trigger_rate_hz", kMinTriggerRateHz, kMaxTriggerRateHz));
   set(p.pacing, s.choice<TriggerPacing>("pacing", {{"periodic", TriggerPacing::kPeriodic},
                                                    {"lockstep", TriggerPacing::kLockstep}}));
@@ -354,7 +361,7 @@ void read_velocity(const YAML::Node& node, kinematics::RateFilterConfig& c) {
   if (const auto v = positive(s, "min_position_sd_mm", 10.0)) c.min_position_sd_mm = *v;
 }
 
-Expected<RunConfig> parse(const std::string& path, const YAML::Node& root) {
+Expected<RunConfig> parse(const std::string& path, const YAML::Node& root, ConfigRole role) {
   RunConfig cfg;
   cfg.path = path;
   const std::string dir = fs::path(path).parent_path().string();
@@ -362,9 +369,10 @@ Expected<RunConfig> parse(const std::string& path, const YAML::Node& root) {
   const Section top(
       root, "",
       {"version", "cameras", "rig", "targets", "model", "pipeline", "outputs", "detection",
-       "stereo", "identification", "velocity", "sim", "service", "fault_injection"});
+       "stereo", "identification", "velocity", "sim", "service", "fault_injection", "node"});
   (void)top.integer("version", 1, 1);  // the only version so far; checked for the future
-  if (top.has("cameras")) read_cameras(top.node("cameras"), base, cfg);
+  if (top.has("cameras")) read_cameras(top.node("cameras"), base, cfg, role);
+  config_detail::read_node_section(top.node("node"), cfg.node);
   if (const auto v = top.text("rig")) cfg.rig_path = resolve(base, *v);
   if (const auto v = top.text("targets")) cfg.targets_path = resolve(base, *v);
   if (const auto v = top.text("model")) cfg.model_path = resolve(base, *v);
@@ -429,7 +437,8 @@ Expected<RunConfig> parse(const std::string& path, const YAML::Node& root) {
 
 }  // namespace
 
-Expected<RunConfig> load_run_config(const std::string& path, bool targets_required) {
+Expected<RunConfig> load_run_config(const std::string& path, bool targets_required,
+                                    ConfigRole role) {
   std::string text;
   if (auto r = formats_detail::read_text_file(path, text, formats_detail::kMaxYamlFileBytes); !r)
     return r.error();
@@ -439,9 +448,11 @@ Expected<RunConfig> load_run_config(const std::string& path, bool targets_requir
     if (!root.IsMap())
       fail("top level",
            "expected a map, got " + formats_detail::describe(root) + line_suffix(root));
-    return parse(path, root);
+    return parse(path, root, role);
   });
   if (!cfg) return cfg;
+  if (role == ConfigRole::kNode)
+    return cfg;  // no tracker on a node: `mocap node` opens the cameras
   if (auto r = check_tracking_assets(*cfg, targets_required); !r) return r.error();
   return cfg;
 }

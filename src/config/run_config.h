@@ -27,7 +27,7 @@
 
 namespace mocap::config {
 
-enum class CameraBackend : std::uint8_t { kSim, kReplay, kV4l2, kLibcamera };
+enum class CameraBackend : std::uint8_t { kSim, kReplay, kV4l2, kLibcamera, kNode };
 
 const char* to_string(CameraBackend b) noexcept;
 const char* to_string(TriggerMode t) noexcept;
@@ -35,8 +35,15 @@ const char* to_string(TriggerMode t) noexcept;
 struct CameraSettings {
   CameraBackend backend = CameraBackend::kSim;
   // v4l2: the device node (/dev/video0); libcamera: a camera id or index ("0");
-  // replay: the recording folder (absolute after loading); sim: empty.
+  // replay: the recording folder (absolute after loading); sim: empty; node: NODE/CAMERA
+  // (a camera of a `mocap node`).
   std::string device;
+  // replay: `camera: NAME`, the recording's camera this one plays (empty: the camera at
+  // the same position).
+  std::string recording_camera;
+  // `trigger: central` (on a `mocap node` only): a replay or software-triggered camera
+  // that follows the central tracker's triggers (trigger is then kSoftware).
+  bool central_trigger = false;
   PixelFormat format = PixelFormat::kMono8;  // GREY | Y16
   int width = 0;                             // 0: the device's / recording's native size
   int height = 0;
@@ -60,8 +67,12 @@ struct StageSettings {                      // unset: the default table's value
   std::optional<std::uint32_t> ring_depth;  // input ring slots (capture: unused)
 };
 
+enum class PairBy : std::uint8_t { kSequence, kTimestamp };
+
 struct PipelineSettings {
   double trigger_rate_hz = 100.0;
+  PairBy pair_by = PairBy::kSequence;  // pipeline.pair_by
+  int pair_tolerance_us = 1000;        // pipeline.pair_tolerance_us (pair_by: timestamp)
   TriggerPacing pacing = TriggerPacing::kPeriodic;
   bool realtime = true;     // CPU pinning + SCHED_FIFO (falls back when not permitted)
   bool lock_memory = true;  // mlockall (falls back when not permitted)
@@ -121,6 +132,19 @@ struct FaultSettings {
   std::uint64_t stall_after_frames = 0;  // camera 0 stops delivering after N frames; 0: off
 };
 
+// `node:` (docs/operations.md, "Several PCs"): on a `mocap node`, its name and DDS domain;
+// on the central tracker (cameras of backend node), the domain and the fault timing.
+struct NodeSettings {
+  std::string name;  // empty: the host name (mocap node)
+  std::uint32_t domain_id = 0;
+  int timeout_ms = 100;  // central: a frame not arrived this long after its trigger is missing
+  double wait_s = 10.0;  // central: how long start waits for every node to be discovered
+};
+
+// Which command reads the configuration: `mocap node` takes 1..8 cameras of its own PC
+// and `trigger: central`, needs no targets; `mocap run` (central) takes 2..kMaxCameras.
+enum class ConfigRole : std::uint8_t { kCentral, kNode };
+
 struct RunConfig {
   std::string path;  // the file it was loaded from; empty for the built-in defaults
   // The rig's cameras in rig order, kMinCameras..kMaxCameras, all of one backend. Without
@@ -135,6 +159,7 @@ struct RunConfig {
   SimSettings sim;
   ServiceSettings service;
   FaultSettings faults;
+  NodeSettings node;
 };
 
 // The ranges of the settings a command-line flag may also set, and their one check:
@@ -156,7 +181,8 @@ RunConfig default_run_config();
 // model files (and the recording of the replay backend) to check that they fit together
 // with the thresholds (FrameProcessor::create). Cameras are NOT opened.
 // targets_required = false: record/preview (tracking_assets.h).
-Expected<RunConfig> load_run_config(const std::string& path, bool targets_required = true);
+Expected<RunConfig> load_run_config(const std::string& path, bool targets_required = true,
+                                    ConfigRole role = ConfigRole::kCentral);
 
 // "HOST:PORT" with a non-empty host and a port in 1..65535 (the publisher resolves the
 // host). Error names `where`.

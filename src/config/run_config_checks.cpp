@@ -37,6 +37,8 @@ const char* to_string(CameraBackend b) noexcept {
       return "v4l2";
     case CameraBackend::kLibcamera:
       return "libcamera";
+    case CameraBackend::kNode:
+      return "node";
   }
   return "?";
 }

@@ -126,6 +126,7 @@ Expected<void> check_tracking_assets(const RunConfig& cfg, bool targets_required
     }
     case CameraBackend::kV4l2:
     case CameraBackend::kLibcamera:
+    case CameraBackend::kNode:  // the rig file (rig:) is required
       assets = load_tracking_assets(cfg, nullptr, nullptr, nullptr, targets_required);
       break;
   }

@@ -31,13 +31,29 @@ struct ErrorCase {
 #define ASSETS "rig: rig.yaml\ntargets: targets.yaml\n"
 
 const ErrorCase kCases[] = {
+    // Camera nodes (issue 29).
+    {"CentralTriggerOnTheCentral",
+     "cameras: [{backend: replay, device: r, trigger: central}, {backend: replay, device: r}]\n",
+     "cameras[0].trigger: 'central' is for the cameras of a `mocap node` (line 1)"},
+    {"NodeDeviceWithoutSlash",
+     "cameras: [{backend: node, device: a}, {backend: node, device: b/c}]\n",
+     "cameras[0].device: expected NODE/CAMERA (the node's name, its camera's name), got 'a' "
+     "(line 1)"},
+    {"RecordingCameraNotReplay", "cameras: [{backend: sim, camera: x}, {backend: sim}]\n",
+     "cameras[0].camera: only replay cameras play a named camera of a recording (line 1)"},
+    {"NodeNameWithSpace", "node: {name: 'a b'}\n",
+     "node.name: printable characters without spaces or '/', got 'a b' (line 1)"},
+    {"NodeDomainOutOfRange", "node: {domain_id: 300}\n",
+     "node.domain_id: must be in [0, 232], got 300 (line 1)"},
+    {"BadPairBy", "pipeline: {pair_by: time}\n",
+     "pipeline.pair_by: expected sequence|timestamp, got 'time' (line 1)"},
     {"UnknownTopLevelKey", "detetcion: {}\n",
      "detetcion: unknown key (line 1); expected one of: version, cameras, rig, targets, model, "
      "pipeline, outputs, detection, stereo, identification, velocity, sim, service, "
-     "fault_injection"},
+     "fault_injection, node"},
     {"UnknownCameraKey", "cameras: [{backend: sim, exposure: 3}, {backend: sim}]\n",
      "cameras[0].exposure: unknown key (line 1); expected one of: backend, device, format, width, "
-     "height, exposure_us, gain, trigger, frame_rate_hz, buffers"},
+     "height, exposure_us, gain, trigger, frame_rate_hz, buffers, camera"},
     {"DuplicateKey", "sim: {loop_frames: 10}\nsim: {loop_frames: 20}\n",
      "sim: duplicate key (line 2)"},
     {"TopLevelNotAMap", "- 1\n", "top level: expected a map, got a list (line 1)"},
@@ -62,7 +78,7 @@ const ErrorCase kCases[] = {
     {"MissingBackend", "cameras: [{trigger: software}, {backend: sim}]\n",
      "cameras[0].backend: missing key (line 1)"},
     {"UnknownBackend", "cameras: [{backend: usb}, {backend: sim}]\n",
-     "cameras[0].backend: expected sim|replay|v4l2|libcamera, got 'usb' (line 1)"},
+     "cameras[0].backend: expected sim|replay|v4l2|libcamera|node, got 'usb' (line 1)"},
     {"MixedBackends", "cameras: [{backend: sim}, {backend: v4l2, device: /dev/video0}]\n",
      "cameras[1].backend: must match cameras[0].backend (sim), got v4l2 (line 1)"},
     {"V4l2WithoutDevice", "cameras: [{backend: v4l2}, {backend: v4l2, device: /dev/video1}]\n",
@@ -109,7 +125,7 @@ const ErrorCase kCases[] = {
      "/dev/video1}\n",
      "cameras[0].gain: must be in [0, 1e+06], got -1 (line 2)"},
     {"BadTrigger", "cameras: [{backend: sim, trigger: hardware}, {backend: sim}]\n",
-     "cameras[0].trigger: expected free_run|external|software, got 'hardware' (line 1)"},
+     "cameras[0].trigger: expected free_run|external|software|central, got 'hardware' (line 1)"},
     {"ZeroFrameRate", "cameras: [{backend: sim, frame_rate_hz: 0}, {backend: sim}]\n",
      "cameras[0].frame_rate_hz: must be > 0 (line 1)"},
     {"TooFewBuffers", "cameras: [{backend: sim, buffers: 1}, {backend: sim}]\n",

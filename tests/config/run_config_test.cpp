@@ -67,6 +67,42 @@ TEST(RunConfig, MinimalFileKeepsTheDefaults) {
   EXPECT_EQ(cfg->cameras.size(), 2u);
 }
 
+TEST(RunConfig, NodeKeysAreRead) {
+  TempDir dir("cfg_node");
+  // A node: one camera, trigger: central, a named camera of the recording; no tracker.
+  write_file(dir.file("node.yaml"),
+             "node: {name: node-a, domain_id: 7}\n"
+             "cameras: [{backend: replay, device: rec, camera: cam3, trigger: central}]\n");
+  auto node = load_run_config(dir.file("node.yaml"), false, ConfigRole::kNode);
+  ASSERT_TRUE(node) << node.error().message;
+  ASSERT_EQ(node->cameras.size(), 1u);
+  EXPECT_TRUE(node->cameras[0].central_trigger);
+  EXPECT_EQ(node->cameras[0].trigger, TriggerMode::kSoftware);
+  EXPECT_EQ(node->cameras[0].recording_camera, "cam3");
+  EXPECT_EQ(node->node.name, "node-a");
+  EXPECT_EQ(node->node.domain_id, 7u);
+  // The same file is not a central configuration (one camera, trigger: central).
+  EXPECT_FALSE(load_run_config(dir.file("node.yaml")));
+  // The central: node cameras, pairing by timestamp, the fault timing.
+  auto scene = sim::make_scene(sim::SimOptions{});
+  ASSERT_TRUE(scene);
+  ASSERT_TRUE(save_rig(dir.file("rig.yaml"), scene->rig));
+  ASSERT_TRUE(save_targets(dir.file("targets.yaml"), scene->targets));
+  write_file(dir.file("central.yaml"),
+             "node: {domain_id: 7, timeout_ms: 40, wait_s: 2.5}\nrig: rig.yaml\n"
+             "targets: targets.yaml\n"
+             "cameras: [{backend: node, device: node-a/cam0}, {backend: node, device: b/c}]\n"
+             "pipeline: {pair_by: timestamp, pair_tolerance_us: 500}\n");
+  auto central = load_run_config(dir.file("central.yaml"));
+  ASSERT_TRUE(central) << central.error().message;
+  EXPECT_EQ(central->cameras[0].backend, CameraBackend::kNode);
+  EXPECT_EQ(central->cameras[1].device, "b/c");
+  EXPECT_EQ(central->node.timeout_ms, 40);
+  EXPECT_DOUBLE_EQ(central->node.wait_s, 2.5);
+  EXPECT_EQ(central->pipeline.pair_by, PairBy::kTimestamp);
+  EXPECT_EQ(central->pipeline.pair_tolerance_us, 500);
+}
+
 TEST(RunConfig, ThresholdsAndOutputsAreRead) {
   TempDir dir("cfg_thr");
   write_file(dir.file("m.yaml"),

@@ -22,6 +22,7 @@ int fuzz_datagram(const std::uint8_t* data, std::size_t size);       // UDP data
 int fuzz_blob_detector(const std::uint8_t* data, std::size_t size);  // detector on any image
 int fuzz_vrpn(const std::uint8_t* data, std::size_t size);           // VRPN client input
 int fuzz_blob_file(const std::uint8_t* data, std::size_t size);      // blob file reader
+int fuzz_node_message(const std::uint8_t* data, std::size_t size);   // camera-node message
 
 struct FuzzTarget {
   const char* name;  // also the corpus folder name
@@ -38,6 +39,7 @@ inline constexpr FuzzTarget kFuzzTargets[] = {
     {"blob_detector", fuzz_blob_detector},
     {"vrpn", fuzz_vrpn},
     {"blob_file", fuzz_blob_file},
+    {"node_message", fuzz_node_message},
 };
 
 // Aborts with "fuzz invariant failed: <what>" (a finding in both builds).

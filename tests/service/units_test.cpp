@@ -39,14 +39,14 @@ TEST(SystemdUnits, VerifyPasses) {
     GTEST_SKIP() << "systemd-analyze not installed (Debian package 'systemd'; "
                     "deploy/install-deps.sh installs it)";
   TempDir dir("units");
-  for (const char* unit : {"mocap.service", "iox-roudi.service"}) {
+  for (const char* unit : {"mocap.service", "iox-roudi.service", "mocap-node.service"}) {
     const std::string text = read_file(source_dir() + "/deploy/" + unit + ".in");
     ASSERT_FALSE(text.empty()) << unit;
     write_file(dir.file(unit), instantiate(text));
   }
   FILE* p = popen(("cd " + dir.path() +
                    " && SYSTEMD_LOG_COLOR=0 systemd-analyze verify ./mocap.service "
-                   "./iox-roudi.service 2>&1")
+                   "./iox-roudi.service ./mocap-node.service 2>&1")
                       .c_str(),
                   "r");
   ASSERT_NE(p, nullptr);
@@ -149,7 +149,7 @@ TEST(DebianPackage, MaintainerScriptsParseAndHandleBothUnits) {
     const auto p = prerm.find(verb);
     ASSERT_NE(p, std::string::npos) << verb;
     const std::string line = prerm.substr(p, prerm.find('\n', p) - p);
-    for (const char* unit : {"mocap.service", "iox-roudi.service"})
+    for (const char* unit : {"mocap.service", "iox-roudi.service", "mocap-node.service"})
       EXPECT_NE(line.find(unit), std::string::npos) << line;
   }
   const std::string postinst = read_file(dir + "postinst.in");

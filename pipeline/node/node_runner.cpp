@@ -1,0 +1,211 @@
+// Design: see node_runner.h.
+#include "pipeline/node/node_runner.h"
+
+#include <algorithm>
+#include <cstdio>
+
+#include "core/clock.h"
+
+namespace mocap::node {
+
+Expected<std::unique_ptr<NodeRunner>> NodeRunner::create(std::vector<NodeCameraSpec> cameras,
+                                                         const detect::DetectorConfig& detect,
+                                                         const NodeOptions& options,
+                                                         NodeSender& sender) {
+  const int n = static_cast<int>(cameras.size());
+  if (n < 1 || n > kMaxNodeCameras)
+    return make_error(
+        "mocap node", "cameras",
+        std::to_string(n) + " cameras, expected 1.." + std::to_string(kMaxNodeCameras));
+  if (detect.max_blobs > static_cast<int>(kMaxBlobsPerMessage))
+    return make_error(
+        "mocap node", "detection.max_blobs",
+        "at most " + std::to_string(kMaxBlobsPerMessage) + " on a node (one message)");
+  if (!(options.trigger_rate_hz > 0.0))
+    return make_error("mocap node", "pipeline.trigger_rate_hz", "must be > 0");
+  std::unique_ptr<NodeRunner> r(new NodeRunner(std::move(cameras), options, sender));
+  for (const NodeCameraSpec& s : r->cams_) {
+    if (s.camera == nullptr) return make_error("mocap node", "cameras", "camera missing");
+    const hal::CameraConfig& cc = s.camera->config();
+    auto d = detect::BlobDetector::create(detect, cc.width, cc.height);
+    if (!d) return make_error("mocap node", "detection (" + s.name + ")", d.error().message);
+    r->lists_.push_back(d->make_blob_list());
+    r->detectors_.push_back(std::move(d).value());
+    r->states_.push_back(std::make_unique<CamState>());
+    auto w = std::make_unique<WireFrame>();
+    set_name(w->header.node, options.node_name.c_str());
+    set_name(w->header.camera, s.name.c_str());
+    if (!valid_name(w->header.node) || !valid_name(w->header.camera))
+      return make_error("mocap node", "node.name / camera " + s.name,
+                        "names are 1..63 printable characters without spaces");
+    r->staging_.push_back(std::move(w));
+  }
+  return r;
+}
+
+NodeRunner::~NodeRunner() { stop(); }
+
+Expected<void> NodeRunner::start() {
+  if (running_) return make_error("mocap node", "start", "already running");
+  notes_.clear();
+  stop_.store(false, std::memory_order_relaxed);  // no thread runs yet
+  ended_.store(0, std::memory_order_relaxed);
+  for (std::size_t c = 0; c < cams_.size(); ++c) {
+    if (auto r = cams_[c].camera->start(); !r) {
+      for (std::size_t s = 0; s < c; ++s) cams_[s].camera->stop();
+      return r.error();
+    }
+  }
+  running_ = true;
+  for (int c = 0; c < static_cast<int>(cams_.size()); ++c) {
+    rt::ThreadSpec spec{"mocap-node" + std::to_string(c), -1, options_.realtime ? 80 : 0};
+    auto t = rt::start_thread(spec, [this, c] { run(c); });
+    if (!t) {
+      stop();
+      return t.error();
+    }
+    if (!t->setup().note.empty()) notes_.push_back(t->setup().note);
+    threads_.push_back(std::move(t).value());
+  }
+  return {};
+}
+
+void NodeRunner::stop() noexcept {
+  if (!running_) return;
+  // release: the camera threads' acquire loads see the stop.
+  stop_.store(true, std::memory_order_release);
+  for (std::size_t c = 0; c < cams_.size(); ++c) sender_.trigger_bell(static_cast<int>(c)).ring();
+  for (rt::RtThread& t : threads_) {
+    if (t.joinable()) t.join();
+  }
+  threads_.clear();
+  for (const NodeCameraSpec& s : cams_) s.camera->stop();
+  running_ = false;
+}
+
+std::uint64_t NodeRunner::published() const noexcept {
+  std::uint64_t n = 0;
+  for (const auto& s : states_) n += s->frames.get();
+  return n;
+}
+
+std::string NodeRunner::report() const {
+  std::string out;
+  for (std::size_t c = 0; c < cams_.size(); ++c) {
+    const CamState& s = *states_[c];
+    char line[256];
+    std::snprintf(line, sizeof line,
+                  "camera %s: frames %llu, queue_dropped %llu, timeouts %llu, errors %llu, "
+                  "detect_overflow %llu\n",
+                  cams_[c].name.c_str(), static_cast<unsigned long long>(s.frames.get()),
+                  static_cast<unsigned long long>(sender_.queue(static_cast<int>(c)).dropped()),
+                  static_cast<unsigned long long>(s.timeouts.get()),
+                  static_cast<unsigned long long>(s.errors.get()),
+                  static_cast<unsigned long long>(s.overflow.get()));
+    out += line;
+  }
+  return out;
+}
+
+void NodeRunner::take_triggers(int c) noexcept {
+  CamState& st = *states_[static_cast<std::size_t>(c)];
+  hal::Camera& cam = *cams_[static_cast<std::size_t>(c)].camera;
+  TriggerStamp t;
+  while (st.count < std::size(st.pending) && sender_.triggers(c).try_pop(t)) {
+    if (cam.trigger() != hal::CameraStatus::kOk) {
+      st.errors.add();
+      continue;
+    }
+    st.triggers.add();
+    st.pending[(st.head + st.count) % std::size(st.pending)] = t;
+    ++st.count;
+  }
+}
+
+void NodeRunner::send(int c, const hal::Frame* f, std::uint16_t flags,
+                      const TriggerStamp& t) noexcept {
+  const auto ci = static_cast<std::size_t>(c);
+  CamState& st = *states_[ci];
+  WireFrame& w = *staging_[ci];
+  WireHeader& h = w.header;
+  detect::BlobList& list = lists_[ci];
+  list.clear();
+  const bool image = f != nullptr && !f->missing && !f->image.empty();
+  if (image && !detectors_[ci].detect(f->image, list)) st.overflow.add();
+  if (f != nullptr && !image) flags |= kWireMissing;
+  if (cams_[ci].replay) flags |= kWireReplay;
+  h.flags = flags;
+  h.frame_number = t.number;
+  h.capture_ns = f != nullptr ? f->timestamp_ns : 0;
+  h.trigger_sent_ns = t.sent_ns;
+  h.trigger_received_ns = t.received_ns;
+  h.detected_ns = monotonic_ns();
+  const hal::CameraCounters& cc = cams_[ci].camera->counters();
+  h.health = {st.frames.get(), cc.dropped.get(), sender_.queue(c).dropped(), st.overflow.get(),
+              st.timeouts.get()};
+  const detect::BlobList::Levels& lv = list.levels();
+  h.background_dn = lv.background_dn;
+  h.noise_dn = lv.noise_dn;
+  h.threshold_dn = lv.threshold_dn;
+  h.blob_count = image ? encode_blobs(list, w.blobs, sizeof w.blobs) : 0;
+  sender_.queue(c).push(w);  // drop-oldest: counted in the queue's dropped()
+  sender_.wake();
+}
+
+void NodeRunner::run(int c) noexcept {
+  const auto ci = static_cast<std::size_t>(c);
+  hal::Camera& cam = *cams_[ci].camera;
+  CamState& st = *states_[ci];
+  const bool central = cams_[ci].central;
+  const bool software = !central && cam.config().trigger == hal::TriggerMode::kSoftware;
+  const auto period_ns = static_cast<std::int64_t>(1e9 / options_.trigger_rate_hz);
+  std::int64_t next_ns = monotonic_ns();
+  pipeline::Doorbell& bell = sender_.trigger_bell(c);
+  while (!stop_.load(std::memory_order_acquire)) {
+    int timeout_ms = 20;
+    if (central) {
+      const std::uint32_t seen = bell.snapshot();
+      take_triggers(c);
+      if (st.count == 0) {  // nothing released: wait for the next central trigger
+        bell.wait(seen, 10'000'000);
+        continue;
+      }
+    } else if (software) {
+      const std::int64_t now = monotonic_ns();
+      if (now >= next_ns) {
+        if (cam.trigger() != hal::CameraStatus::kOk) st.errors.add();
+        st.triggers.add();
+        next_ns += period_ns;
+        if (next_ns < now) next_ns = now + period_ns;  // overran: re-phase
+      }
+      timeout_ms =
+          static_cast<int>(std::clamp<std::int64_t>((next_ns - monotonic_ns()) / 1'000'000, 0, 20));
+    }
+    hal::Frame f;
+    const hal::CameraStatus s = cam.dequeue(f, timeout_ms);
+    if (s == hal::CameraStatus::kTimeout || s == hal::CameraStatus::kAgain) {
+      if (s == hal::CameraStatus::kTimeout) st.timeouts.add();
+      continue;
+    }
+    if (s == hal::CameraStatus::kEndOfStream) {
+      send(c, nullptr, kWireEndOfStream, TriggerStamp{});
+      ended_.fetch_add(1, std::memory_order_acq_rel);  // finished() acquires it
+      break;
+    }
+    if (s != hal::CameraStatus::kOk) {
+      st.errors.add();
+      continue;
+    }
+    TriggerStamp t{f.sequence, 0, 0};
+    if (central && st.count > 0) {
+      t = st.pending[st.head];
+      st.head = (st.head + 1) % static_cast<std::uint32_t>(std::size(st.pending));
+      --st.count;
+    }
+    st.frames.add();
+    send(c, &f, 0, t);
+    if (cam.release(f) != hal::CameraStatus::kOk) st.errors.add();
+  }
+}
+
+}  // namespace mocap::node

@@ -1,0 +1,134 @@
+// Design: see node_sender.h.
+#include "pipeline/node/node_sender.h"
+
+#include "core/clock.h"
+
+namespace mocap::node {
+
+Expected<std::unique_ptr<NodeSender>> NodeSender::create(std::uint32_t domain_id,
+                                                         const std::vector<bool>& central,
+                                                         int queue_depth) {
+  const int n = static_cast<int>(central.size());
+  if (n < 1 || n > kMaxNodeCameras)
+    return make_error("mocap node", "cameras", "1.." + std::to_string(kMaxNodeCameras));
+  std::unique_ptr<NodeSender> s(new NodeSender());
+  auto d = NodeDomain::open(domain_id, "mocap node");
+  if (!d) return d.error();
+  s->domain_ = std::move(d).value();
+  auto w = s->domain_.writer(s->domain_.blob_topic(), "mocap node: mocap/blobs");
+  if (!w) return w.error();
+  s->writer_ = *w;
+  auto r = s->domain_.reader(s->domain_.trigger_topic(), "mocap node: mocap/trigger");
+  if (!r) return r.error();
+  s->trigger_reader_ = *r;
+  s->waitset_ = dds_create_waitset(s->domain_.participant());
+  const dds_entity_t cond = dds_create_readcondition(s->trigger_reader_, DDS_ANY_STATE);
+  if (s->waitset_ < 0 || cond < 0 || dds_waitset_attach(s->waitset_, cond, 0) < 0)
+    return make_error("mocap node", "mocap/trigger", "cannot create the DDS waitset");
+  s->central_ = central;
+  s->trigger_bells_ = std::make_unique<pipeline::Doorbell[]>(static_cast<std::size_t>(n));
+  for (int c = 0; c < n; ++c) {
+    auto q = rt::DropOldestQueue<WireFrame>::create(queue_depth);
+    if (!q) return q.error();
+    s->queues_.push_back(std::move(q).value());
+    auto ring = rt::SpscRing<TriggerStamp>::create(1024);
+    if (!ring) return ring.error();
+    s->triggers_.push_back(std::make_unique<rt::SpscRing<TriggerStamp>>(std::move(ring).value()));
+  }
+  return s;
+}
+
+NodeSender::~NodeSender() { stop(false); }
+
+Expected<void> NodeSender::start() {
+  stop_.store(false, std::memory_order_relaxed);  // no thread runs yet
+  auto a = rt::start_thread(rt::ThreadSpec{"mocap-nsend", -1, 0}, [this] { send_loop(); });
+  if (!a) return a.error();
+  send_thread_ = std::move(a).value();
+  auto b = rt::start_thread(rt::ThreadSpec{"mocap-ntrig", -1, 0}, [this] { trigger_loop(); });
+  if (!b) {
+    stop(false);
+    return b.error();
+  }
+  trigger_thread_ = std::move(b).value();
+  return {};
+}
+
+void NodeSender::stop(bool flush) noexcept {
+  // release: the threads' acquire loads see everything queued before the stop.
+  stop_.store(true, std::memory_order_release);
+  bell_.ring();
+  if (send_thread_.joinable()) send_thread_.join();
+  if (trigger_thread_.joinable()) trigger_thread_.join();
+  if (flush && writer_ > 0) {
+    while (send_pending()) {
+    }
+    (void)dds_wait_for_acks(writer_, DDS_SECS(2));
+  }
+}
+
+std::uint32_t NodeSender::matched_readers() const noexcept {
+  dds_publication_matched_status_t st{};
+  if (writer_ <= 0 || dds_get_publication_matched_status(writer_, &st) < 0) return 0;
+  return st.current_count;
+}
+
+bool NodeSender::send_pending() noexcept {
+  bool any = false;
+  for (auto& q : queues_) {
+    while (const WireFrame* f = q->front()) {
+      mocap_node_BlobFrame s{};
+      to_sample(f->header, s);
+      s.sent_ns = realtime_ns();
+      s.realtime_offset_ns = s.sent_ns - monotonic_ns();
+      s.blobs._maximum = s.blobs._length =
+          static_cast<std::uint32_t>(f->header.blob_count * kBlobRecordBytes);
+      s.blobs._buffer = const_cast<std::uint8_t*>(f->blobs);  // DDS only reads it
+      s.blobs._release = false;
+      if (dds_write(writer_, &s) < 0) {
+        write_errors_.add();
+      } else {
+        sent_.add();
+      }
+      q->release();
+      any = true;
+    }
+  }
+  return any;
+}
+
+void NodeSender::send_loop() noexcept {
+  while (!stop_.load(std::memory_order_acquire)) {
+    const std::uint32_t seen = bell_.snapshot();
+    if (!send_pending()) bell_.wait(seen, 10'000'000);
+  }
+}
+
+void NodeSender::trigger_loop() noexcept {
+  constexpr int kBatch = 32;
+  void* samples[kBatch] = {};
+  dds_sample_info_t infos[kBatch];
+  while (!stop_.load(std::memory_order_acquire)) {
+    (void)dds_waitset_wait(waitset_, nullptr, 0, DDS_MSECS(20));
+    for (;;) {
+      const dds_return_t n = dds_take(trigger_reader_, samples, infos, kBatch, kBatch);
+      if (n <= 0) break;
+      const std::int64_t now = realtime_ns();
+      for (dds_return_t i = 0; i < n; ++i) {
+        if (!infos[i].valid_data) continue;
+        const auto* t = static_cast<const mocap_node_Trigger*>(samples[i]);
+        triggers_in_.add();
+        for (std::size_t c = 0; c < central_.size(); ++c) {
+          if (!central_[c]) continue;
+          if (!triggers_[c]->try_push(TriggerStamp{t->trigger_number, t->sent_ns, now}))
+            triggers_dropped_.add();
+          trigger_bells_[c].ring();
+        }
+      }
+      (void)dds_return_loan(trigger_reader_, samples, n);
+      samples[0] = nullptr;  // the next take loans again
+    }
+  }
+}
+
+}  // namespace mocap::node

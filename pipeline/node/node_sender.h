@@ -1,0 +1,81 @@
+// Design: the DDS side of `mocap node` (issue 29), two non-real-time threads between the
+// node's camera threads (node_runner.h) and the network:
+//   - sender (`mocap-nsend`): takes every camera's messages from its bounded drop-oldest
+//     queue (rt::DropOldestQueue<WireFrame>, one per camera: one producer each; drops are
+//     counted and reported in the camera's health), stamps sent_ns and writes them to
+//     mocap/blobs. The camera threads never touch DDS (it locks and allocates).
+//   - trigger reader (`mocap-ntrig`): takes mocap/trigger samples and hands each trigger
+//     (number, central send time, node receive time) to every camera with `trigger:
+//     central` through its SPSC ring, then rings that camera's doorbell.
+// Setup allocates (queues of depth x 139 KiB per camera); the camera-thread side
+// (queue push, trigger ring pop, doorbells) is noexcept, lock-free and allocation-free.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "pipeline/doorbell.h"
+#include "pipeline/node/node_dds.h"
+#include "rt/counter.h"
+#include "rt/drop_oldest_queue.h"
+#include "rt/spsc_ring.h"
+#include "rt/thread.h"
+
+namespace mocap::node {
+
+struct TriggerStamp {
+  std::uint64_t number = 0;
+  std::int64_t sent_ns = 0;      // central CLOCK_REALTIME
+  std::int64_t received_ns = 0;  // node CLOCK_REALTIME
+};
+
+class NodeSender {
+ public:
+  // central[c]: camera c follows the central triggers. queue_depth: messages per camera.
+  static Expected<std::unique_ptr<NodeSender>> create(std::uint32_t domain_id,
+                                                      const std::vector<bool>& central,
+                                                      int queue_depth);
+  ~NodeSender();
+
+  Expected<void> start();
+  // Stops both threads; first sends what is queued and waits (bounded) for the readers'
+  // acknowledgements when `flush`.
+  void stop(bool flush) noexcept;
+
+  // Camera thread c (its producer ends).
+  rt::DropOldestQueue<WireFrame>& queue(int c) noexcept { return *queues_[idx(c)]; }
+  void wake() noexcept { bell_.ring(); }
+  rt::SpscRing<TriggerStamp>& triggers(int c) noexcept { return *triggers_[idx(c)]; }
+  pipeline::Doorbell& trigger_bell(int c) noexcept { return trigger_bells_[idx(c)]; }
+
+  // Any thread.
+  std::uint64_t sent() const noexcept { return sent_.get(); }
+  std::uint64_t write_errors() const noexcept { return write_errors_.get(); }
+  std::uint64_t triggers_received() const noexcept { return triggers_in_.get(); }
+  std::uint64_t triggers_dropped() const noexcept { return triggers_dropped_.get(); }
+  // Matched central readers of mocap/blobs (0 when unknown).
+  std::uint32_t matched_readers() const noexcept;
+
+ private:
+  NodeSender() = default;
+  static std::size_t idx(int c) noexcept { return static_cast<std::size_t>(c); }
+  void send_loop() noexcept;
+  bool send_pending() noexcept;  // true when something was written
+  void trigger_loop() noexcept;
+
+  NodeDomain domain_;
+  dds_entity_t writer_ = 0, trigger_reader_ = 0, waitset_ = 0;
+  std::vector<bool> central_;
+  std::vector<std::unique_ptr<rt::DropOldestQueue<WireFrame>>> queues_;
+  std::vector<std::unique_ptr<rt::SpscRing<TriggerStamp>>> triggers_;
+  std::unique_ptr<pipeline::Doorbell[]> trigger_bells_;
+  pipeline::Doorbell bell_;
+  std::atomic<bool> stop_{false};
+  rt::RtThread send_thread_, trigger_thread_;
+  rt::Counter sent_, write_errors_, triggers_in_, triggers_dropped_;
+};
+
+}  // namespace mocap::node
