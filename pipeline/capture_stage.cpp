@@ -160,6 +160,7 @@ void CaptureStage::run() noexcept {
         pushed = wait_first_frame(last_trigger_ns, last_sequence, end_of_stream);
       if (pushed) wait_retired(last_sequence, last_trigger_ns, end_of_stream);
     }
+    if (triggered_mode && end_of_stream && !pushed) k.triggers_past_end.add();
   }
   context_.loop_end(StageId::kCapture);
 }

@@ -102,6 +102,9 @@ class CaptureStage {
     rt::CounterGroup group;
     rt::NamedCounter triggered{group, "triggered"};
     rt::NamedCounter trigger_errors{group, "trigger_errors"};
+    // triggers no camera answered because the source ended (a replay's or a node's end of
+    // stream): not frames, so not losses (mocap record's accounting)
+    rt::NamedCounter triggers_past_end{group, "triggers_past_end"};
     rt::NamedCounter trigger_overruns{group, "trigger_overruns"};        // periods skipped (late)
     rt::NamedCounter trigger_late_max_us{group, "trigger_late_max_us"};  // vs its deadline
     rt::CameraCounters dequeue_timeouts{group, "dequeue_timeouts_cam#"};

@@ -13,6 +13,7 @@
 // --blobs: the detector's blob lists (the pipeline's detect stages, the configuration's
 // detection settings, every frame in order) in place of images, blobs/<camera>.blobs
 // (formats/blob_file.h); --keep-images N also keeps every Nth frame's images as PGM.
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <csignal>
@@ -121,10 +122,13 @@ int record(const RecordArgs& a) {
   cli.no_iceoryx = true;
   auto cfg = service::resolve_run_config(a.config, cli, false);
   if (!cfg) return fail(cfg.error().message);
-  if (cfg->cameras[0].backend == config::CameraBackend::kNode)
+  if (cfg->cameras[0].backend == config::CameraBackend::kNode && !a.blobs)
     return fail(cfg->path +
-                ": cameras[0].backend: node: mocap record writes images and node cameras send blob "
-                "lists (blob recordings, `mocap record --blobs`, are not in this build)");
+                ": cameras[0].backend: node: node cameras send blob lists, no images: record "
+                "them with `mocap record --blobs`");
+  if (cfg->cameras[0].backend == config::CameraBackend::kNode && a.keep_given)
+    return fail(cfg->path +
+                ": cameras[0].backend: node: --keep-images: node cameras send no images");
   if (auto r = record::prepare_output_dir(a.out); !r) return fail(r.error().message);
   std::signal(SIGINT, on_record_signal);
   std::signal(SIGTERM, on_record_signal);
@@ -142,8 +146,12 @@ int record(const RecordArgs& a) {
   const std::vector<hal::Camera*> cams = (*live)->cameras();
   for (std::size_t c = 0; c < cams.size(); ++c) {  // every camera of the rig: one folder each
     const hal::CameraConfig& cc = cams[c]->config();
-    ro.camera_names.push_back((*live)->assets().rig.cameras[c].name);
-    ro.cameras.push_back(record::CameraGeometry{cc.width, cc.height, cc.format});
+    const CameraModel& rig_camera = (*live)->assets().rig.cameras[c];
+    ro.camera_names.push_back(rig_camera.name);
+    // A node camera has no image size of its own (it sends blob lists): the rig's.
+    const bool sized = cc.width > 0 && cc.height > 0;
+    ro.cameras.push_back(record::CameraGeometry{sized ? cc.width : rig_camera.width,
+                                                sized ? cc.height : rig_camera.height, cc.format});
   }
   ro.slots_per_camera = static_cast<std::uint32_t>(a.buffer_frames);
   // A replay ends with its source: the pipeline triggers its frames (lockstep: one frame
@@ -272,7 +280,14 @@ int record(const RecordArgs& a) {
                  elapsed_s > 0.0 ? static_cast<double>(k.bytes_written) / 1e6 / elapsed_s : 0.0,
                  camera_rate_mb_s(ro, opt.trigger_rate_hz));
   }
-  report_losses((*pipe)->stats().triggered, k);
+  {
+    // The triggers that found the source's end (a replay's, a node's) are no frames.
+    const pipeline::PipelineStats stats = (*pipe)->stats();
+    std::uint64_t past_end = 0;
+    for (const auto& [name, value] : stats.counters)
+      if (name == "triggers_past_end") past_end = value;
+    report_losses(stats.triggered - std::min(past_end, stats.triggered), k);
+  }
   if (!finished) {
     std::fprintf(stderr, "mocap: %s (the recording keeps the %llu frames written before)\n",
                  finished.error().message.c_str(),

@@ -4,7 +4,8 @@
 // them. Checked against the same recording replayed in one process: every frame is
 // published and the joint angles (UDP datagrams) are equal within 1e-5 rad; with one node
 // killed mid-run the central goes on publishing from the other node's cameras and ends
-// normally when the replay ends; the node restarted is used again. Each test uses its own DDS
+// normally when the replay ends; the node restarted is used again; `mocap record --blobs`
+// of the two nodes tracks to the image recording's poses. Each test uses its own DDS
 // domain id (no cross-talk between concurrent test processes).
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -97,7 +98,8 @@ class NodeCluster : public ::testing::Test {
   // Both nodes in the background, the central in the foreground; `kill_after_s` > 0
   // SIGKILLs node n1 that long after the central started, `restart_after_s` > 0 starts it
   // again that much later (its replay starts at its first frame again).
-  test::RunResult run_cluster(double kill_after_s, double restart_after_s = 0.0) {
+  test::RunResult run_cluster(double kill_after_s, double restart_after_s = 0.0,
+                              const std::string& central = "run") {
     const std::string m = test::mocap_binary();
     const std::string d = "'" + dir_ + "'";
     std::string cmd = "cd " + d + " && " + m +
@@ -112,10 +114,14 @@ class NodeCluster : public ::testing::Test {
             " node --config node1.yaml --duration 20 > node1b.log 2>&1 & echo $! > node1b.pid; }";
       cmd += ") & ";
     }
-    cmd += "timeout 120 " + m + " run --config " + d + "/central.yaml --stats-interval 0 > " + d +
-           "/central.log 2>&1; rc=$?; wait; [ -f " + d + "/node1b.pid ] && kill $(cat " + d +
-           "/node1b.pid); sleep 0.5; cat " + d + "/central.log " + d + "/node0.log; [ -f " + d +
-           "/node1b.log ] && cat " + d + "/node1b.log; exit $rc";
+    const std::string how = central == "run"
+                                ? " run --config " + d + "/central.yaml --stats-interval 0"
+                                : " record --blobs --config " + d + "/central.yaml --out " + d +
+                                      "/blobrec --progress-interval 0";
+    cmd += "timeout 120 " + m + how + " > " + d + "/central.log 2>&1; rc=$?; wait; [ -f " + d +
+           "/node1b.pid ] && kill $(cat " + d + "/node1b.pid); sleep 0.5; cat " + d +
+           "/central.log " + d + "/node0.log; [ -f " + d + "/node1b.log ] && cat " + d +
+           "/node1b.log; exit $rc";
     return test::run_command(cmd);
   }
   std::string dir_;
@@ -183,6 +189,28 @@ TEST_F(NodeCluster, AKilledNodesCamerasGoMissingComeBackAndTheRunEndsNormally) {
   EXPECT_GT(sent_again, 0) << r.output;
   const long central_frames = std::stol(r.output.substr(at + 21));
   EXPECT_GT(central_frames, sent_again - 3) << r.output;  // a few may come late
+}
+
+// `mocap record --blobs` takes node cameras: the blob recording of the two nodes tracks
+// to the same poses as the image recording they replayed.
+TEST_F(NodeCluster, BlobRecordingOfTwoNodesTracksAsTheImages) {
+  write_cluster(test::free_udp_port(), 100.0, 5000);
+  const test::RunResult r = run_cluster(0.0, 0.0, "record");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find(std::to_string(kFrames) + " frames triggered, " +
+                          std::to_string(kFrames) + " written, 0 not written"),
+            std::string::npos)
+      << r.output;
+  const std::string targets = " --targets " + recording() + "/targets.yaml --quiet";
+  const test::RunResult a =
+      test::run_mocap("track " + recording() + targets + " --out '" + dir_ + "/from_images'", 120);
+  ASSERT_EQ(a.exit_code, 0) << a.output;
+  const test::RunResult b = test::run_mocap(
+      "track '" + dir_ + "/blobrec'" + targets + " --out '" + dir_ + "/from_blobs'", 120);
+  ASSERT_EQ(b.exit_code, 0) << b.output;
+  const std::string poses_images = test::read_file(dir_ + "/from_images/poses.csv");
+  EXPECT_GT(poses_images.size(), 1000u);
+  EXPECT_EQ(test::read_file(dir_ + "/from_blobs/poses.csv"), poses_images);
 }
 
 }  // namespace
