@@ -135,8 +135,6 @@ void print_json(const client::JointsMessage& m, std::uint64_t gap, double age_ms
       ",\"age_ms\":" + json_number(age_ms, true) + ",\"gap\":" + std::to_string(gap) +
       ",\"flags\":" + std::to_string(m.flags) +
       ",\"all_bodies_found\":" + ((m.flags & client::kFlagAllBodiesFound) ? "true" : "false") +
-      ",\"predicted_lead_us\":" +
-      ((m.flags & client::kFlagPredicted) ? std::to_string(m.lead_us) : std::string("null")) +
       ",\"joints\":[";
   for (std::size_t j = 0; j < m.joint_count && j < client::kMaxJoints; ++j) {
     const client::JointRecord& r = m.joints[j];
@@ -153,7 +151,9 @@ void print_json(const client::JointsMessage& m, std::uint64_t gap, double age_ms
         ",\"rate_sd_rad_s\":" + (rates ? json_array(m.rates[j].sd_rad_s, 3) : std::string("null")) +
         "}";
   }
-  s += "]}\n";
+  s += "],\"predicted_lead_us\":" +
+       ((m.flags & client::kFlagPredicted) ? std::to_string(m.lead_us) : std::string("null")) +
+       "}\n";
   std::fputs(s.c_str(), stdout);
 }
 
