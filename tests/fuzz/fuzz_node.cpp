@@ -43,7 +43,7 @@ int fuzz_node_message(const std::uint8_t* data, std::size_t size) {
     h.flags &= kWireReplay;
     repair_name(h.node);
     repair_name(h.camera);
-    h.blob_count = static_cast<std::uint32_t>(blob_bytes / kBlobRecordBytes);
+    h.blob_count = static_cast<std::uint32_t>(blob_bytes / node::kBlobRecordBytes);
     if (!std::isfinite(h.background_dn)) h.background_dn = 0.0;
     if (!std::isfinite(h.noise_dn)) h.noise_dn = 0.0;
     if (!std::isfinite(h.threshold_dn)) h.threshold_dn = 0.0;
@@ -58,7 +58,8 @@ int fuzz_node_message(const std::uint8_t* data, std::size_t size) {
   fuzz_check(valid_name(h.node) && valid_name(h.camera), "accepted a bad name");
   fuzz_check(out.size() == h.blob_count && h.blob_count <= 16,
              "accepted a count that is not the list's");
-  fuzz_check(blob_bytes == h.blob_count * kBlobRecordBytes, "accepted bytes of the wrong size");
+  fuzz_check(blob_bytes == h.blob_count * node::kBlobRecordBytes,
+             "accepted bytes of the wrong size");
   for (const detect::Blob& b : out)
     fuzz_check(std::isfinite(b.x_px) && std::isfinite(b.y_px) && b.x_min <= b.x_max,
                "accepted a bad blob");
