@@ -184,12 +184,15 @@ void expect_stage_threads_do_not_allocate(SimRigFixture& rig, std::uint64_t fram
   PipelineOptions opt = test::test_options();
   opt.hooks = &hooks;
   opt.max_frames = frames;
+  // Lockstep: every frame reaches the sink however slow the build (TSan, a loaded CI);
+  // at the trigger rate a sanitizer build drops frames and the count would be timing.
+  opt.pacing = TriggerPacing::kLockstep;
   auto p = Pipeline::create(rig.processor(), rig.cameras(), {&sink}, opt);
   ASSERT_TRUE(p.ok()) << p.error().message;
   ASSERT_TRUE((*p)->start().ok());
-  test::wait_finished(**p);
+  test::wait_finished(**p, 120.0);
   (*p)->stop();
-  EXPECT_GT(sink.count(), frames / 2);
+  EXPECT_EQ(sink.count(), frames);
   // The multi-view merger's counters are reported with three or more cameras only.
   const PipelineStats st = (*p)->stats();
   const bool has_multiview = std::any_of(st.counters.begin(), st.counters.end(), [](const auto& c) {
