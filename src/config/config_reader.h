@@ -64,6 +64,7 @@ class Section {
 namespace mocap::config {
 struct CameraSettings;
 struct NodeSettings;
+struct OutputSettings;
 struct PipelineSettings;
 }  // namespace mocap::config
 
@@ -75,6 +76,9 @@ namespace mocap::config_detail {
 void read_node_camera_keys(const Section& s, config::CameraSettings& cam);
 void read_node_section(const YAML::Node& node, config::NodeSettings& n);
 void read_pair_keys(const Section& s, config::PipelineSettings& p);
+
+// The `outputs:` map (run_config_outputs.cpp); `file` prefixes the registry outputs' errors.
+void read_outputs(const std::string& file, const YAML::Node& node, config::OutputSettings& o);
 
 // Empty when `value` is a valid HOST:PORT, else the problem (run_config_checks.cpp).
 std::string host_port_problem(const std::string& value);
