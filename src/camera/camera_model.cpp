@@ -6,15 +6,6 @@
 
 namespace mocap {
 
-Vec2 distort_normalized(const CameraModel& cam, const Vec2& xn) noexcept {
-  const auto& d = cam.distortion;
-  const double x = xn.x(), y = xn.y();
-  const double r2 = x * x + y * y;
-  const double radial = 1.0 + r2 * (d[0] + r2 * (d[1] + r2 * d[4]));
-  return Vec2(x * radial + 2.0 * d[2] * x * y + d[3] * (r2 + 2.0 * x * x),
-              y * radial + d[2] * (r2 + 2.0 * y * y) + 2.0 * d[3] * x * y);
-}
-
 Eigen::Matrix2d distort_jacobian(const CameraModel& cam, const Vec2& xn) noexcept {
   const auto& d = cam.distortion;
   const double x = xn.x(), y = xn.y();
@@ -28,11 +19,6 @@ Eigen::Matrix2d distort_jacobian(const CameraModel& cam, const Vec2& xn) noexcep
   J(1, 0) = y * dradial * 2.0 * x + d[2] * 2.0 * x + 2.0 * d[3] * y;
   J(1, 1) = radial + y * dradial * 2.0 * y + d[2] * 6.0 * y + 2.0 * d[3] * x;
   return J;
-}
-
-Vec2 normalized_to_pixel(const CameraModel& cam, const Vec2& xn) noexcept {
-  const Vec2 xd = distort_normalized(cam, xn);
-  return Vec2(cam.fx * xd.x() + cam.cx, cam.fy * xd.y() + cam.cy);
 }
 
 bool project(const CameraModel& cam, const Vec3& X_world, Vec2& px) noexcept {

@@ -35,13 +35,25 @@ struct Rig {
   std::vector<CameraModel> cameras;  // the first two form the stereo pair
 };
 
-// Normalised undistorted (x', y') -> normalised distorted (x'', y'').
-Vec2 distort_normalized(const CameraModel& cam, const Vec2& xn) noexcept;
+// Normalised undistorted (x', y') -> normalised distorted (x'', y''). Inline with the
+// pixel mapping and project() below: the N-view merge projects thousands of points per
+// frame.
+inline Vec2 distort_normalized(const CameraModel& cam, const Vec2& xn) noexcept {
+  const auto& d = cam.distortion;
+  const double x = xn.x(), y = xn.y();
+  const double r2 = x * x + y * y;
+  const double radial = 1.0 + r2 * (d[0] + r2 * (d[1] + r2 * d[4]));
+  return Vec2(x * radial + 2.0 * d[2] * x * y + d[3] * (r2 + 2.0 * x * x),
+              y * radial + d[2] * (r2 + 2.0 * y * y) + 2.0 * d[3] * x * y);
+}
 // Jacobian d(x'', y'') / d(x', y').
 Eigen::Matrix2d distort_jacobian(const CameraModel& cam, const Vec2& xn) noexcept;
 
 // Normalised undistorted -> pixel, and pixel -> normalised distorted.
-Vec2 normalized_to_pixel(const CameraModel& cam, const Vec2& xn) noexcept;
+inline Vec2 normalized_to_pixel(const CameraModel& cam, const Vec2& xn) noexcept {
+  const Vec2 xd = distort_normalized(cam, xn);
+  return Vec2(cam.fx * xd.x() + cam.cx, cam.fy * xd.y() + cam.cy);
+}
 
 // World point -> pixel. Returns false (px untouched) when the point is not in front
 // of the camera (z <= 1e-9 mm).

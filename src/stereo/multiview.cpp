@@ -83,9 +83,13 @@ void MultiViewMerger::extend(int i) noexcept {
   for (int c = 0; c < camera_count(); ++c) {
     const BlobGrid& grid = grids_[static_cast<std::size_t>(c)];
     if (h.blob_index[c] >= 0 || grid.size() == 0) continue;  // no blob: nothing to find
-    Vec2 q;
-    if (!project(cams_[static_cast<std::size_t>(c)], h.X_world, q)) continue;  // behind
-    const double wide = std::max(config_.gate_px, unfit_gate_px(c, h.X_world));
+    // project() and unfit_gate_px() from one camera-frame point (the same values).
+    const CameraModel& cam = cams_[static_cast<std::size_t>(c)];
+    const Vec3 Xc = cam.R_cam_world * h.X_world + cam.t_cam_world;
+    if (!(Xc.z() > 1e-9)) continue;  // behind
+    const Vec2 q = normalized_to_pixel(cam, Vec2(Xc.x() / Xc.z(), Xc.y() / Xc.z()));
+    const double wide =
+        std::max(config_.gate_px, config_.gate_px + cam.fx * config_.marker_radius_mm / Xc.z());
     double best_d2 = 0.0;
     const int best = indexed ? grid.nearest(q, wide, best_d2) : grid.nearest_scan(q, wide, best_d2);
     if (best < 0) continue;

@@ -37,30 +37,89 @@ bool triangulate_linear_nview(const CameraModel* const* cams, const Vec2* xn, in
   return true;
 }
 
+namespace {
+
+// The residual project(cam, X) - obs (real pixels) and, when J is non-null, its 2x3
+// Jacobian d(px)/d(X_world): the chain of project()'s, written out (pixels from the
+// distortion's 2x2 Jacobian times the pinhole's 2x3 times R) with no temporaries. False
+// when the point is not in front of the camera (as project()).
+inline bool residual(const CameraModel& cam, const Vec3& X, const Vec2& obs, Vec2& r,
+                     double* J) noexcept {
+  const Mat3& R = cam.R_cam_world;
+  const Vec3 Xc = R * X + cam.t_cam_world;
+  if (!(Xc.z() > 1e-9)) return false;
+  const double iz = 1.0 / Xc.z();
+  const double x = Xc.x() * iz, y = Xc.y() * iz;
+  const auto& d = cam.distortion;
+  const double r2 = x * x + y * y;
+  const double radial = 1.0 + r2 * (d[0] + r2 * (d[1] + r2 * d[4]));
+  const double xd = x * radial + 2.0 * d[2] * x * y + d[3] * (r2 + 2.0 * x * x);
+  const double yd = y * radial + d[2] * (r2 + 2.0 * y * y) + 2.0 * d[3] * x * y;
+  r = Vec2(cam.fx * xd + cam.cx - obs.x(), cam.fy * yd + cam.cy - obs.y());
+  if (J == nullptr) return true;
+  const double dradial = d[0] + r2 * (2.0 * d[1] + 3.0 * r2 * d[4]);
+  // A = diag(fx, fy) * d(xd, yd)/d(x, y), scaled by 1/z (the pinhole's Jacobian).
+  const double a00 =
+      cam.fx * iz * (radial + 2.0 * x * x * dradial + 2.0 * d[2] * y + 6.0 * d[3] * x);
+  const double a01 = cam.fx * iz * (2.0 * x * y * dradial + 2.0 * d[2] * x + 2.0 * d[3] * y);
+  const double a10 = cam.fy * iz * (2.0 * x * y * dradial + 2.0 * d[2] * x + 2.0 * d[3] * y);
+  const double a11 =
+      cam.fy * iz * (radial + 2.0 * y * y * dradial + 6.0 * d[2] * y + 2.0 * d[3] * x);
+  // d(px)/d(Xc) = [a00 a01 -(a00 x + a01 y); a10 a11 -(a10 x + a11 y)], then times R.
+  const double b02 = -(a00 * x + a01 * y), b12 = -(a10 * x + a11 * y);
+  for (int c = 0; c < 3; ++c) {
+    J[c] = a00 * R(0, c) + a01 * R(1, c) + b02 * R(2, c);
+    J[3 + c] = a10 * R(0, c) + a11 * R(1, c) + b12 * R(2, c);
+  }
+  return true;
+}
+
+}  // namespace
+
 bool refine_gauss_newton(const CameraModel* const* cams, const Vec2* px, int n, Vec3& X_world,
                          double& rms_px, int max_iterations) noexcept {
   if (n < 1 || n > kMaxCameras) return false;
   Vec3 X = X_world;
   bool last = max_iterations <= 0;
   for (int it = 0;; ++it) {
-    Mat3 H = Mat3::Zero();
-    Vec3 g = Vec3::Zero();
+    // Normal equations H step = g, H = sum J^T J (upper triangle), g = sum J^T r.
+    double h00 = 0, h01 = 0, h02 = 0, h11 = 0, h12 = 0, h22 = 0, g0 = 0, g1 = 0, g2 = 0;
     double sq = 0.0;
     for (int k = 0; k < n; ++k) {
-      Vec2 p;
-      Eigen::Matrix<double, 2, 3> J;
-      if (!project(*cams[k], X, p, J)) return false;
-      const Vec2 r = p - px[k];
+      Vec2 r;
+      double J[6];
+      if (!residual(*cams[k], X, px[k], r, last ? nullptr : J)) return false;
       sq += r.squaredNorm();
-      H.noalias() += J.transpose() * J;
-      g.noalias() += J.transpose() * r;
+      if (last) continue;
+      const double* u = J;
+      const double* v = J + 3;
+      h00 += u[0] * u[0] + v[0] * v[0];
+      h01 += u[0] * u[1] + v[0] * v[1];
+      h02 += u[0] * u[2] + v[0] * v[2];
+      h11 += u[1] * u[1] + v[1] * v[1];
+      h12 += u[1] * u[2] + v[1] * v[2];
+      h22 += u[2] * u[2] + v[2] * v[2];
+      g0 += u[0] * r.x() + v[0] * r.y();
+      g1 += u[1] * r.x() + v[1] * r.y();
+      g2 += u[2] * r.x() + v[2] * r.y();
     }
     rms_px = std::sqrt(sq / static_cast<double>(n));
     X_world = X;
     if (last) break;
-    const Eigen::LDLT<Mat3> ldlt(H);
-    if (ldlt.info() != Eigen::Success) break;
-    const Vec3 step = ldlt.solve(g);
+    // Cholesky of the 3x3 (positive definite with two or more views not on one ray; a
+    // non-positive pivot: no step, as an LDLT failure).
+    const double l00 = h00;
+    if (!(l00 > 0.0)) break;
+    const double l10 = h01 / l00, l20 = h02 / l00;
+    const double l11 = h11 - l10 * h01;
+    if (!(l11 > 0.0)) break;
+    const double l21 = (h12 - l20 * h01) / l11;
+    const double l22 = h22 - l20 * h02 - l21 * l21 * l11;
+    if (!(l22 > 0.0)) break;
+    // L D L^T: forward (unit lower), divide by D, backward.
+    const double y0 = g0, y1 = g1 - l10 * y0, y2 = g2 - l20 * y0 - l21 * y1;
+    const double z2 = y2 / l22, z1 = y1 / l11 - l21 * z2, z0 = y0 / l00 - l10 * z1 - l20 * z2;
+    const Vec3 step(z0, z1, z2);
     if (!step.allFinite()) break;
     X -= step;
     // After a converged step (or the last allowed one) evaluate once more and stop.

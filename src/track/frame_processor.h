@@ -76,6 +76,7 @@ struct TrackerConfig {
 
 // Wall-clock duration of each stage of one frame (ns). `detect` covers every camera.
 struct StageTimesNs {
+  std::int64_t load = 0;  // reading the frame from a recording (offline only; not in frame)
   std::int64_t detect = 0;
   std::int64_t triangulate = 0;
   std::int64_t identify = 0;

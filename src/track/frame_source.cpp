@@ -18,8 +18,10 @@ FrameSource::FrameSource(const Recording& rec, FrameProcessor& proc, int detect_
 FrameSource::Result FrameSource::load(std::int64_t frame, FrameOutput& out) {
   Result r;
   const int n = proc_.camera_count();
+  const std::int64_t t_read = monotonic_ns();
   if (!rec_.has_blobs()) {
     const FrameSetLoader::Result loaded = images_->load(frame);
+    out.times.load = monotonic_ns() - t_read;
     r.missing = loaded.missing;
     r.damaged = loaded.damaged;
     r.problem = loaded.problem;
@@ -40,7 +42,6 @@ FrameSource::Result FrameSource::load(std::int64_t frame, FrameOutput& out) {
     out.times.detect = monotonic_ns() - t0;
     return r;
   }
-  const std::int64_t t0 = monotonic_ns();
   for (int c = 0; c < n; ++c) {
     const auto uc = static_cast<std::size_t>(c);
     out.camera_present[uc] = false;
@@ -55,15 +56,18 @@ FrameSource::Result FrameSource::load(std::int64_t frame, FrameOutput& out) {
       ++r.present;
     }
   }
-  out.times.detect = monotonic_ns() - t0;
+  out.times.load = monotonic_ns() - t_read;
+  out.times.detect = 0;  // nothing to detect: the recording holds the blob lists
   return r;
 }
 
 FrameSource::Result FrameSource::process(const FrameEntry& entry, FrameOutput& out) {
-  const std::int64_t t0 = monotonic_ns();
   Result r = load(entry.frame, out);
+  const std::int64_t t0 = monotonic_ns();
   proc_.process_blobs(entry.timestamp_ns, out);
-  out.times.frame = monotonic_ns() - t0;
+  // The in-memory work (the spec's `frame`): detection and the stages after it, without
+  // the file reading (times.load).
+  out.times.frame = out.times.detect + (monotonic_ns() - t0);
   return r;
 }
 

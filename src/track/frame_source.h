@@ -8,7 +8,9 @@
 // does, so the stages after detection compute the same result from either source. A
 // camera whose frame is absent (no PGM, no chunk) is missing (a dropped frame); a damaged
 // one is reported (problem, one line naming the file) and treated as missing.
-// times.detect is the detection (images) or the reading of the blob lists (blobs).
+// times.load is the file reading (the PGMs, or the blob lists), times.detect the detection
+// (0 for blob recordings); times.frame, the in-memory work, leaves the reading out (the
+// spec's stats.json: "file reading excluded").
 // Offline code: allocates at construction and while buffers grow, not per frame after.
 #pragma once
 
@@ -38,7 +40,7 @@ class FrameSource {
   FrameSource& operator=(const FrameSource&) = delete;
 
   bool from_blobs() const noexcept { return rec_.has_blobs(); }
-  // Stage 1 of frame `frame`: out.blobs, out.camera_present, out.times.detect.
+  // Stage 1 of frame `frame`: out.blobs, out.camera_present, out.times.load and .detect.
   Result load(std::int64_t frame, FrameOutput& out);
   // load() and the stages after it (FrameProcessor::process_blobs), as process() does.
   Result process(const FrameEntry& entry, FrameOutput& out);

@@ -218,6 +218,7 @@ std::string format_track_summary(const OfflineTrackResult& r) {
   }
   if (r.stats) {
     const std::pair<const char*, const LatencyHistogram*> stages[] = {
+        {"load", &r.stats->load},
         {"detect", &r.stats->detect},
         {"triangulate", &r.stats->triangulate},
         {"identify", &r.stats->identify},

@@ -36,6 +36,7 @@ std::string stats_to_json(const TrackStats& stats) {
                 static_cast<long long>(stats.frames));
   out += buf;
   const std::pair<const char*, const LatencyHistogram*> stages[] = {
+      {"load", &stats.load},
       {"detect", &stats.detect},
       {"triangulate", &stats.triangulate},
       {"identify", &stats.identify},

@@ -18,6 +18,7 @@ namespace mocap {
 // at most 1/64 above the exact nearest-rank value, fixed memory whatever the length).
 struct TrackStats {
   void record(const StageTimesNs& t) noexcept {
+    load.record(t.load);
     detect.record(t.detect);
     triangulate.record(t.triangulate);
     identify.record(t.identify);
@@ -26,7 +27,7 @@ struct TrackStats {
   }
 
   std::int64_t frames = 0;
-  LatencyHistogram detect, triangulate, identify, angles, frame;
+  LatencyHistogram load, detect, triangulate, identify, angles, frame;
   std::vector<std::pair<std::string, std::uint64_t>> counters;  // filled at the end
 };
 

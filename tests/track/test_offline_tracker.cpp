@@ -110,8 +110,9 @@ TEST(OfflineTracker, WritesTheSpecFilesAndStats) {
   EXPECT_GT(all.linear_mm_s.rms, 0.1 * all.linear_mm_s.rms_sd);
   EXPECT_LT(all.angular_deg_s.rms, 4.0 * all.angular_deg_s.rms_sd);
   const std::string stats = test::read_file(out.file("stats.json"));
-  for (const char* key : {"\"frames\": 12", "\"detect\"", "\"triangulate\"", "\"identify\"",
-                          "\"angles\"", "\"frame\"", "\"p50_us\"", "\"p99_us\"", "\"max_us\""}) {
+  for (const char* key :
+       {"\"frames\": 12", "\"load\"", "\"detect\"", "\"triangulate\"", "\"identify\"", "\"angles\"",
+        "\"frame\"", "\"p50_us\"", "\"p99_us\"", "\"max_us\""}) {
     EXPECT_NE(stats.find(key), std::string::npos) << key;
   }
 }
