@@ -156,6 +156,7 @@ int run_node(const NodeArgs& a) {
       if (!cam) return fail(cam.error().message);
       want = (*cam)->native_config();
       spec.replay = true;
+      if (s.central_trigger) spec.seekable = cam->get();  // plays the frame a trigger names
       cams.push_back(std::move(cam).value());
     } else {  // v4l2 (plan_node)
       auto cam = hal::V4l2Camera::open(s.device);
