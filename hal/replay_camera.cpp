@@ -2,6 +2,7 @@
 // an absolute deadline (no drift over a long replay).
 #include "hal/replay_camera.h"
 
+#include <algorithm>
 #include <ctime>
 
 namespace mocap::hal {
@@ -84,6 +85,7 @@ Expected<void> ReplayCamera::start() {
   ahead_ = std::move(*ahead);
   held_.assign(static_cast<std::size_t>(config_.buffer_count), false);
   next_ = 0;
+  skipped_ = 0;
   triggers_ = 0;
   reset_sequence();
   start_ns_ = monotonic_ns();
@@ -101,6 +103,18 @@ CameraStatus ReplayCamera::trigger() noexcept {
   if (state_ != CameraState::kStreaming) return CameraStatus::kNotStreaming;
   if (config_.trigger != TriggerMode::kSoftware) return CameraStatus::kUnsupported;
   ++triggers_;
+  return CameraStatus::kOk;
+}
+
+CameraStatus ReplayCamera::seek(std::size_t index) noexcept {
+  if (state_ != CameraState::kStreaming) return CameraStatus::kNotStreaming;
+  if (index < next_) return CameraStatus::kUnsupported;  // earlier frames: restart it
+  const std::size_t to = std::min(index, recording_->frames().size());
+  if (to == next_) return CameraStatus::kOk;
+  skipped_ += to - next_;
+  next_ = to;
+  ahead_->skip_to(static_cast<std::uint32_t>(to));
+  reset_sequence();  // a jump on purpose: not frames the camera dropped
   return CameraStatus::kOk;
 }
 
@@ -134,12 +148,17 @@ CameraStatus ReplayCamera::dequeue(Frame& out, int timeout_ms) noexcept {
   // The frame is loaded ahead (replay_read_ahead.h); a loader behind the replay is
   // waited for within the timeout.
   ReplayReadAhead::Loaded loaded;
-  if (!ahead_->wait_next(loaded, monotonic_ns() + (timeout_ms > 0 ? timeout_ns : 0))) {
-    counters_.timeouts.add();
-    return CameraStatus::kTimeout;
+  const std::int64_t deadline = monotonic_ns() + (timeout_ms > 0 ? timeout_ns : 0);
+  for (;;) {
+    if (!ahead_->wait_next(loaded, deadline)) {
+      counters_.timeouts.add();
+      return CameraStatus::kTimeout;
+    }
+    if (loaded.frame_index >= next_) break;
+    ahead_->give_back(loaded.buffer);  // loaded before a seek() passed it
   }
   const FrameEntry& entry = frames[loaded.frame_index];  // == next_: loaded in order
-  ++next_;
+  next_ = loaded.frame_index + 1;
   if (config_.trigger == TriggerMode::kSoftware) --triggers_;
   bool missing = true;
   if (loaded.status == ReplayReadAhead::Status::kError) {

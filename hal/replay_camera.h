@@ -14,10 +14,13 @@
 // true and an empty image, and the replay goes on; after the last frame dequeue returns
 // kEndOfStream.
 // Trigger modes: kFreeRun (paced as above) and kSoftware (each trigger() releases
-// the next frame); kExternal falls back to kFreeRun with a notice. Exposure, gain and
-// frame rate are the recording's (notice).
-// State, config, notice, counters and the dropped-frame count from gaps in the
-// recording's frame numbers are kept by CameraBase (hal/camera_base.h).
+// the next frame); kExternal falls back to kFreeRun with a notice. seek(index) makes
+// frame `index` (never an earlier one) the next delivered: a camera node's `trigger:
+// central` replay plays the frame the central's trigger names, so that a node restarted
+// mid-run resumes in step (the frames in between are neither read nor counted as dropped).
+// Exposure, gain and frame rate are the recording's (notice). State, config, notice, counters and
+// the dropped-frame count from gaps in the recording's frame numbers are kept by CameraBase
+// (hal/camera_base.h).
 #pragma once
 
 #include <cstdint>
@@ -46,6 +49,10 @@ class ReplayCamera final : public CameraBase {
   CameraStatus trigger() noexcept override;
   CameraStatus dequeue(Frame& out, int timeout_ms) noexcept override;
   CameraStatus release(const Frame& frame) noexcept override;
+  // Streaming: frame `index` of recording.frames() is the next one delivered (at or past
+  // the end: kEndOfStream next). kOk; kUnsupported for an index below the next frame.
+  CameraStatus seek(std::size_t index) noexcept;
+  std::uint64_t skipped() const noexcept { return skipped_; }  // frames seek() passed over
 
   // The configuration matching the recording (size of the rig's camera, 8-bit).
   CameraConfig native_config() const;
@@ -61,6 +68,7 @@ class ReplayCamera final : public CameraBase {
   std::size_t next_ = 0;        // index into recording_->frames()
   std::uint64_t triggers_ = 0;  // software triggers not yet consumed
   std::int64_t start_ns_ = 0;
+  std::uint64_t skipped_ = 0;  // the capture thread's
 };
 
 }  // namespace mocap::hal

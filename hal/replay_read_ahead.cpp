@@ -3,6 +3,7 @@
 
 #include <pthread.h>
 
+#include <algorithm>
 #include <utility>
 
 #include "core/clock.h"
@@ -75,6 +76,11 @@ void ReplayReadAhead::give_back(std::uint32_t buffer) noexcept {
   wake();
 }
 
+void ReplayReadAhead::skip_to(std::uint32_t index) noexcept {
+  skip_to_.store(index, std::memory_order_relaxed);  // wake()'s release publishes it
+  wake();
+}
+
 bool ReplayReadAhead::wait_next(Loaded& out, std::int64_t deadline_ns) noexcept {
   for (;;) {
     if (loaded_.try_pop(out)) return true;
@@ -93,6 +99,7 @@ void ReplayReadAhead::run() noexcept {
     // acquire: pairs with wake()'s release; read before looking, so a wake between the
     // look and the wait is not lost (the wait returns at once on a changed value).
     const std::uint32_t seen = wake_.load(std::memory_order_acquire);
+    next = std::max<std::size_t>(next, skip_to_.load(std::memory_order_relaxed));
     if (next < frames.size() && (have_buffer || free_.try_pop(buffer))) {
       have_buffer = true;
       Image& image = images_[buffer];

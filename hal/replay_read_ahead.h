@@ -13,7 +13,10 @@
 //   left to load; give_back() and the destructor wake it. It runs with the default
 //   scheduling policy: the pipeline's SCHED_FIFO stages preempt it, so it reads while
 //   they are idle.
-// Setup (start) allocates the images, rings and thread; next(), wait_next() and
+// skip_to(index) makes the loader go on at frame `index` (never back) without reading
+// the frames before it; entries it loaded before are still handed out (the consumer
+// gives those back unused).
+// Setup (start) allocates the images, rings and thread; next(), wait_next(), skip_to() and
 // give_back() are noexcept and allocation-free (the capture thread's hot path); the
 // loader's reads allocate nothing either (Recording::load_frame into a sized Image).
 #pragma once
@@ -66,6 +69,8 @@ class ReplayReadAhead {
   const Image& image(std::uint32_t buffer) const noexcept { return images_[buffer]; }
   // The consumer is done with `buffer`: it may be loaded again.
   void give_back(std::uint32_t buffer) noexcept;
+  // The loader's next frame is at least `index` (into recording.frames()).
+  void skip_to(std::uint32_t index) noexcept;
 
  private:
   ReplayReadAhead(std::shared_ptr<const Recording> rec, int camera_index, std::vector<Image> images,
@@ -81,6 +86,7 @@ class ReplayReadAhead {
   rt::SpscRing<std::uint32_t> free_;  // capture thread -> loader
   rt::SpscRing<Loaded> loaded_;       // loader -> capture thread
   std::atomic<std::uint32_t> wake_{0};
+  std::atomic<std::uint32_t> skip_to_{0};  // consumer -> loader: the lowest frame to load
   std::atomic<bool> stop_{false};
   std::thread thread_;
 };

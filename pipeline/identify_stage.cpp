@@ -1,6 +1,7 @@
 // Design: see identify_stage.h.
 #include "pipeline/identify_stage.h"
 
+#include <algorithm>
 #include <string>
 #include <utility>
 
@@ -14,8 +15,9 @@ Expected<std::unique_ptr<IdentifyStage>> IdentifyStage::create(std::uint32_t inp
                                                                rt::SlotPool<MsgSlot>& out) {
   const PipelineOptions& o = context.options();
   const std::int64_t tolerance = o.pair_by == PairBy::kTimestamp ? o.pair_tolerance_us * 1000 : 0;
-  auto pairer =
-      hal::FramePairer::create(hal::PairerConfig{tolerance, input_depth, processor.camera_count()});
+  hal::PairerConfig pc{tolerance, input_depth, processor.camera_count(), {}};
+  pc.silent_after_ns = o.silent_after_ns;
+  auto pairer = hal::FramePairer::create(pc);
   if (!pairer) return pairer.error();
   std::unique_ptr<IdentifyStage> s(
       new IdentifyStage(context, processor, out, std::move(pairer).value()));
@@ -54,8 +56,17 @@ void IdentifyStage::count_unpaired(std::uint64_t sequence) noexcept {
 }
 
 void IdentifyStage::release_set(const hal::FramePair& set) noexcept {
-  for (int c = 0; c < cameras_; ++c)
-    inputs_[static_cast<std::size_t>(c)]->release(set.cam[c].handle);
+  for (int c = 0; c < cameras_; ++c) {
+    if (set.cam[c].handle != hal::kAbsentHandle)
+      inputs_[static_cast<std::size_t>(c)]->release(set.cam[c].handle);
+  }
+}
+
+int IdentifyStage::first_present(const hal::FramePair& set) const noexcept {
+  for (int c = 0; c < cameras_; ++c) {
+    if (set.cam[c].handle != hal::kAbsentHandle) return c;
+  }
+  return 0;  // unreachable: a set holds the frame that completed it
 }
 
 void IdentifyStage::run() noexcept {
@@ -70,29 +81,36 @@ void IdentifyStage::run() noexcept {
   const bool by_time = context_.options().pair_by == PairBy::kTimestamp;
   bool have_set = false;
   hal::FramePair set{};
+  auto take = [&](const hal::FramePair& p) {
+    count_unpaired(sequence_of(p));
+    if (have_set) {  // drop-oldest: a newer set is complete
+      counters_.skipped.add();
+      const std::uint64_t dropped = sequence_of(set);
+      release_set(set);
+      context_.retire(dropped);
+    }
+    set = p;
+    have_set = true;
+  };
   while (!context_.stopping()) {
     const std::uint32_t seen = bell.snapshot();
+    const std::int64_t now = monotonic_ns();
+    hal::FramePair p;
     for (int c = 0; c < cameras_; ++c) {
       rt::SlotPool<BlobSlot>& pool = *inputs_[static_cast<std::size_t>(c)];
       rt::SlotHandle h;
       while (pool.pop(h)) {
-        hal::FramePair p;
         const std::int64_t key =
             by_time ? pool[h].capture_ns : static_cast<std::int64_t>(pool[h].sequence);
-        if (!pairer_.push(c, hal::PairEntry{key, h}, p, on_drop)) continue;
-        count_unpaired(sequence_of(p));
-        if (have_set) {  // drop-oldest: a newer set is complete
-          counters_.skipped.add();
-          const std::uint64_t dropped = sequence_of(set);
-          release_set(set);
-          context_.retire(dropped);
-        }
-        set = p;
-        have_set = true;
+        if (pairer_.push(c, hal::PairEntry{key, h}, p, on_drop, now)) take(p);
       }
     }
+    // Silent cameras (camera nodes, PipelineOptions::silent_after_ns): the sets that
+    // waited for them long enough complete without them.
+    while (pairer_.expire(now, p)) take(p);
     if (!have_set) {
-      bell.wait(seen, kIdleWaitNs);
+      const std::int64_t until_silence = pairer_.next_silence_ns() - now;
+      bell.wait(seen, std::clamp<std::int64_t>(until_silence, 1, kIdleWaitNs));
       continue;
     }
     have_set = false;
@@ -106,11 +124,17 @@ void IdentifyStage::process(const hal::FramePair& set) noexcept {
   FrameOutput& out = *frame_;
   for (int c = 0; c < cameras_; ++c) {
     const auto ci = static_cast<std::size_t>(c);
+    if (set.cam[c].handle == hal::kAbsentHandle) {  // a silent camera: no frame
+      out.blobs[ci].clear();
+      out.camera_present[ci] = false;
+      continue;
+    }
     BlobSlot& slot = (*inputs_[ci])[set.cam[c].handle];
     std::swap(out.blobs[ci], slot.blobs);  // O(1), same capacities: no allocation
     out.camera_present[ci] = slot.present;
   }
-  const BlobSlot& first = (*inputs_[0])[set.cam[0].handle];
+  const int f = first_present(set);
+  const BlobSlot& first = (*inputs_[static_cast<std::size_t>(f)])[set.cam[f].handle];
   const std::uint64_t sequence = first.sequence;
   const std::int64_t capture_ns = first.capture_ns;  // the data's time: published as is
   const std::int64_t origin_ns = first.origin_ns;    // the latencies' start
@@ -158,6 +182,13 @@ void IdentifyStage::report(rt::CounterReport& out) const {
     out.emplace_back(rt::counter_name("pair_unmatched_cam#", c), pc.unmatched[c].get());
   for (int c = 0; c < cameras_; ++c)
     out.emplace_back(rt::counter_name("pair_overflow_cam#", c), pc.overflow[c].get());
+  if (context_.options().has_silent_bounds()) {  // camera nodes: silent cameras
+    for (int c = 0; c < cameras_; ++c)
+      out.emplace_back(rt::counter_name("pair_silent_cam#", c), pc.silent[c].get());
+    for (int c = 0; c < cameras_; ++c)
+      out.emplace_back(rt::counter_name("pair_absent_cam#", c), pc.absent[c].get());
+    out.emplace_back("frames_without_silent_cameras", pc.partial.get());
+  }
   counters_.group.report(cameras_, out);
   for (std::size_t i = 0; i < kStereoFields.size(); ++i)
     out.emplace_back(std::string("stereo_") + kStereoFields[i].name, library_.stereo.get(i));

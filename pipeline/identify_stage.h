@@ -10,6 +10,10 @@
 // capture, a detector or the pairer dropped them) are counted once each when the next
 // set forms (frames_unpaired): sets form in increasing sequence order. Every dropped
 // sequence is retired (StageContext::retire) so lockstep pacing goes on.
+// Silent cameras (PipelineOptions::silent_after_ns, camera nodes the central does not
+// trigger): the pairer completes the sets that waited for such a camera past its bound
+// without it (its blobs empty, camera_present false); the wait is bounded by the next
+// such deadline, so a silent node's cameras cost one bound, not a stall.
 // Latencies (identify, and publish's end to end) start at camera 0's latency origin
 // (hal::latency_origin_ns: the trigger, or a replay's delivery), carried in the slots;
 // the published capture_ns is the frame's own timestamp (a replay's: the recording's).
@@ -64,8 +68,10 @@ class IdentifyStage {
                 hal::FramePairer pairer);
   void count_unpaired(std::uint64_t sequence) noexcept;
   void release_set(const hal::FramePair& set) noexcept;
+  int first_present(const hal::FramePair& set) const noexcept;  // not kAbsentHandle
   std::uint64_t sequence_of(const hal::FramePair& set) const noexcept {
-    return (*inputs_[0])[set.cam[0].handle].sequence;
+    const int c = first_present(set);
+    return (*inputs_[static_cast<std::size_t>(c)])[set.cam[c].handle].sequence;
   }
   void process(const hal::FramePair& set) noexcept;
 

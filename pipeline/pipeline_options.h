@@ -5,6 +5,7 @@
 // and the Pipeline that wires them (pipeline.h) include this header.
 #pragma once
 
+#include <array>
 #include <cstdint>
 
 #include "core/capture_modes.h"
@@ -80,6 +81,17 @@ struct PipelineOptions {
   // kTimestamp only: two frames pair when their timestamps differ by at most this; must
   // be below half the frame period.
   std::int64_t pair_tolerance_us = 1000;
+  // Per camera (hal::FramePairer): how long (ns) the other cameras' frames wait for its
+  // frame before it counts as silent and the sets go on without it (pair_silent_cam#,
+  // pair_absent_cam#, frames_without_silent_cameras); 0: always waited for. Set for the
+  // camera-node cameras the central does not trigger (service::pipeline_options).
+  std::array<std::int64_t, kMaxCameras> silent_after_ns{};
+  bool has_silent_bounds() const noexcept {
+    for (const std::int64_t b : silent_after_ns) {
+      if (b > 0) return true;
+    }
+    return false;
+  }
   FrameObserver* observer = nullptr;
   StageHooks* hooks = nullptr;
   FrameTap* tap = nullptr;      // `mocap record`: every delivered frame, capture thread

@@ -102,8 +102,13 @@ bool NodeCamera::take() noexcept {
         (next_ - k <= kWindow && delivered_real_[k % kWindow] == k + 1 ? duplicates_ : late_).add();
       }
     } else if (have_last_ && k <= last_number_) {
-      stale = true;
-      (k == last_number_ ? duplicates_ : late_).add();
+      if (mapped_capture_ns(h) > last_mapped_ns_) {  // captured later: the node restarted
+        have_last_ = false;
+        reconnects_.add();
+      } else {
+        stale = true;
+        (k == last_number_ ? duplicates_ : late_).add();
+      }
     }
     if (down_ && !stale) {  // the node is back
       down_ = false;
@@ -123,18 +128,21 @@ bool NodeCamera::take() noexcept {
   return false;
 }
 
+std::int64_t NodeCamera::mapped_capture_ns(const WireHeader& h) noexcept {
+  if ((h.flags & kWireReplay) != 0 || h.realtime_offset_ns == 0) return h.capture_ns;
+  // A live camera's CLOCK_MONOTONIC on the node -> this host's, through CLOCK_REALTIME
+  // (PTP-synchronised across the PCs: pair_by timestamp compares these).
+  const std::int64_t central_offset = realtime_ns() - monotonic_ns();
+  return h.capture_ns + h.realtime_offset_ns - central_offset;
+}
+
 void NodeCamera::deliver_held(hal::Frame& out) noexcept {
   const Received& r = link_->inbox(index_)[held_];
   const std::uint64_t k = r.header.frame_number;
   out = hal::Frame{};
   out.sequence = k;
-  out.timestamp_ns = r.header.capture_ns;
-  if ((r.header.flags & kWireReplay) == 0 && r.header.realtime_offset_ns != 0) {
-    // A live camera's CLOCK_MONOTONIC on the node -> this host's, through CLOCK_REALTIME
-    // (PTP-synchronised across the PCs: pair_by timestamp compares these).
-    const std::int64_t central_offset = realtime_ns() - monotonic_ns();
-    out.timestamp_ns += r.header.realtime_offset_ns - central_offset;
-  }
+  out.timestamp_ns = mapped_capture_ns(r.header);
+  last_mapped_ns_ = out.timestamp_ns;
   out.received_ns = r.received_ns;
   // The latencies start at the central trigger (the node's round trip included).
   out.delivered_ns = central_ ? trigger_ns_[k % kWindow] : r.received_ns;

@@ -16,7 +16,11 @@
 //     ends the run instead of becoming a frame of missing cameras. A message older than the next
 //     frame is late, one already delivered a duplicate: counted and dropped.
 //   kExternal / kFreeRun: the node triggers (hardware line, or free-running): frames are
-//     delivered as they arrive (numbers must increase; older ones are late/duplicates).
+//     delivered as they arrive (numbers must increase; older ones are late/duplicates,
+//     unless captured after the last frame delivered: a restarted node, whose numbers
+//     start over, counted in node_reconnects). Nothing is declared missing here: a silent
+//     node's cameras are left out of the frame sets by the identify stage's pairer after
+//     a bound (PipelineOptions::silent_after_ns: node.timeout_ms plus a frame period).
 // The node's end of stream (its replay ended) is this camera's kEndOfStream.
 // Capture times: a replay's stay the recording's; a live camera's (node CLOCK_MONOTONIC)
 // are mapped onto this host's CLOCK_MONOTONIC through CLOCK_REALTIME (both hosts'
@@ -62,6 +66,8 @@ class NodeCamera final : public hal::CameraBase {
   bool take() noexcept;
   void deliver_held(hal::Frame& out) noexcept;
   void deliver_missing(hal::Frame& out) noexcept;
+  // A message's capture time on this host's CLOCK_MONOTONIC (a replay's: the recording's).
+  static std::int64_t mapped_capture_ns(const WireHeader& h) noexcept;
 
   std::shared_ptr<NodeLink> link_;
   const int index_;
@@ -77,6 +83,7 @@ class NodeCamera final : public hal::CameraBase {
   bool have_last_ = false;
   std::uint64_t last_number_ = 0;  // last real frame number delivered
   std::int64_t last_capture_ns_ = 0, period_ns_ = 0;
+  std::int64_t last_mapped_ns_ = 0;  // mapped_capture_ns of the last real frame delivered
   bool held_valid_ = false;
   rt::SlotHandle held_ = 0;
   rt::Counter late_, duplicates_, reconnects_;

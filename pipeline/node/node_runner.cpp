@@ -96,12 +96,15 @@ std::string NodeRunner::report() const {
     char line[256];
     std::snprintf(line, sizeof line,
                   "camera %s: frames %llu, queue_dropped %llu, timeouts %llu, errors %llu, "
-                  "detect_overflow %llu\n",
+                  "detect_overflow %llu, skipped %llu, behind %llu\n",
                   cams_[c].name.c_str(), static_cast<unsigned long long>(s.frames.get()),
                   static_cast<unsigned long long>(sender_.queue(static_cast<int>(c)).dropped()),
                   static_cast<unsigned long long>(s.timeouts.get()),
                   static_cast<unsigned long long>(s.errors.get()),
-                  static_cast<unsigned long long>(s.overflow.get()));
+                  static_cast<unsigned long long>(s.overflow.get()),
+                  static_cast<unsigned long long>(
+                      cams_[c].seekable != nullptr ? cams_[c].seekable->skipped() : 0),
+                  static_cast<unsigned long long>(s.behind.get()));
     out += line;
   }
   return out;
@@ -170,6 +173,13 @@ void NodeRunner::run(int c) noexcept {
         bell.wait(seen, 10'000'000);
         continue;
       }
+      // A replay plays the frame the oldest pending trigger names (a no-op in step).
+      if (hal::ReplayCamera* r = cams_[ci].seekable;
+          r != nullptr && r->seek(st.pending[st.head].number) == hal::CameraStatus::kUnsupported &&
+          !st.behind_noted) {
+        st.behind.add();  // once per trigger
+        st.behind_noted = true;
+      }
     } else if (software) {
       const std::int64_t now = monotonic_ns();
       if (now >= next_ns) {
@@ -201,6 +211,7 @@ void NodeRunner::run(int c) noexcept {
       t = st.pending[st.head];
       st.head = (st.head + 1) % static_cast<std::uint32_t>(std::size(st.pending));
       --st.count;
+      st.behind_noted = false;
     }
     st.frames.add();
     send(c, &f, 0, t);

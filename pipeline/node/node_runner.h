@@ -6,7 +6,12 @@
 // A camera's end of stream (a replay's end) is sent as an end-of-stream message and ends
 // that thread. Frame numbers: a central-triggered camera's frame carries the number of
 // the central trigger that released it (its own FIFO of received triggers, in order);
-// any other camera's frame its own sequence number.
+// any other camera's frame its own sequence number. A central-triggered replay plays the
+// frame the trigger names (central trigger k: the recording's k-th frame,
+// hal::ReplayCamera::seek), so a node started or restarted mid-run joins in step; the
+// frames it passed over are counted (`skipped` in the report), and a trigger naming a
+// frame already played (the central restarted, the node did not) is counted in `behind`
+// and answered with the next frame, as before.
 // The loop after start() is the hot path: noexcept, no allocation, no lock, no logging;
 // its only syscalls are the camera's and the doorbell's. Health counters (lifetime, this
 // thread the only writer) travel in every message.
@@ -20,6 +25,7 @@
 
 #include "detect/blob_detector.h"
 #include "hal/camera.h"
+#include "hal/replay_camera.h"
 #include "pipeline/node/node_sender.h"
 #include "rt/thread.h"
 
@@ -30,6 +36,9 @@ struct NodeCameraSpec {
   std::string name;               // published camera name
   bool central = false;           // trigger: central
   bool replay = false;            // capture_ns is a recording's timestamp
+  // The same camera when it is a replay that `central` makes follow the central's
+  // trigger numbers (seek); null otherwise.
+  hal::ReplayCamera* seekable = nullptr;
 };
 
 struct NodeOptions {
@@ -59,9 +68,10 @@ class NodeRunner {
 
  private:
   struct CamState {
-    rt::Counter frames, errors, timeouts, overflow, triggers;
+    rt::Counter frames, errors, timeouts, overflow, triggers, behind;
     TriggerStamp pending[64];  // central triggers sent to the camera, oldest first
     std::uint32_t head = 0, count = 0;
+    bool behind_noted = false;  // behind counted for pending[head]
   };
   NodeRunner(std::vector<NodeCameraSpec> cameras, const NodeOptions& options, NodeSender& sender)
       : cams_(std::move(cameras)), options_(options), sender_(sender) {}

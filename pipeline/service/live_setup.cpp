@@ -120,34 +120,6 @@ int check_config_command(const std::string& path) {
   return 0;
 }
 
-pipeline::PipelineOptions pipeline_options(const config::RunConfig& cfg) {
-  pipeline::PipelineOptions o;
-  o.trigger_rate_hz = cfg.pipeline.trigger_rate_hz;
-  o.pacing = cfg.pipeline.pacing;
-  o.realtime = cfg.pipeline.realtime;
-  o.lock_memory = cfg.pipeline.lock_memory;
-  o.cpu_latency_us = cfg.pipeline.cpu_latency_us;
-  o.dequeue_timeout_ms = cfg.pipeline.dequeue_timeout_ms;
-  o.pair_by = cfg.pipeline.pair_by == config::PairBy::kTimestamp ? pipeline::PairBy::kTimestamp
-                                                                 : pipeline::PairBy::kSequence;
-  o.pair_tolerance_us = cfg.pipeline.pair_tolerance_us;
-  for (std::size_t i = 0; i < config::kStageCount; ++i) {
-    const config::StageSettings& s = cfg.pipeline.stages[i];
-    pipeline::StageSpec& d = o.stages.rows[i];
-    if (s.cpu) d.cpu = *s.cpu;
-    if (s.priority) d.fifo_priority = *s.priority;
-    if (s.ring_depth) d.ring_depth = *s.ring_depth;
-  }
-  for (std::size_t c = 0; c < cfg.pipeline.detect_camera.size(); ++c) {  // detect<k>
-    const config::StageSettings& s = cfg.pipeline.detect_camera[c];
-    pipeline::DetectOverride& d = o.stages.detect[c];
-    if (s.cpu) d.cpu = *s.cpu;
-    if (s.priority) d.fifo_priority = *s.priority;
-    if (s.ring_depth) d.ring_depth = *s.ring_depth;
-  }
-  return o;
-}
-
 namespace {
 
 // The configured settings on top of `base` (the backend's native configuration).

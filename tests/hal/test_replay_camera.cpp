@@ -2,8 +2,8 @@
 // with its number and timestamp, a missing file delivered as a missing frame (not a
 // stop), malformed files counted, end of stream, recorded timing honoured (a lower
 // bound: frames never come early), the recorded timestamp kept and the delivery stamped
-// (the latencies' origin), software trigger, buffer exhaustion, and no heap allocation
-// per frame.
+// (the latencies' origin), software trigger, seek (a node's central-triggered replay),
+// buffer exhaustion, and no heap allocation per frame.
 #include <gtest/gtest.h>
 
 #include <memory>
@@ -165,6 +165,38 @@ TEST_F(ReplayFixture, SoftwareTriggerReleasesOneFrameEach) {
   ASSERT_EQ(cam->dequeue(f, 1000), CameraStatus::kOk);
   EXPECT_EQ(f.sequence, 1u);
   EXPECT_EQ(cam->dequeue(f, 0), CameraStatus::kTimeout);
+}
+
+// A camera node's `trigger: central` replay: seek() makes the named frame the next one
+// (its image, number and timestamp), never an earlier one; past the end: end of stream.
+TEST_F(ReplayFixture, SeekPlaysTheNamedFrameAndNeverGoesBack) {
+  auto cam = camera(0, ReplayPacing::kAsFastAsPossible, TriggerMode::kSoftware);
+  Frame f;
+  ASSERT_EQ(cam->trigger(), CameraStatus::kOk);
+  ASSERT_EQ(cam->dequeue(f, 1000), CameraStatus::kOk);
+  EXPECT_EQ(f.sequence, 0u);
+  ASSERT_EQ(cam->release(f), CameraStatus::kOk);
+  ASSERT_EQ(cam->seek(1), CameraStatus::kOk);  // in step: nothing skipped
+  EXPECT_EQ(cam->skipped(), 0u);
+  ASSERT_EQ(cam->seek(3), CameraStatus::kOk);  // frames 1 and 2 (loaded ahead) passed over
+  EXPECT_EQ(cam->skipped(), 2u);
+  ASSERT_EQ(cam->trigger(), CameraStatus::kOk);
+  ASSERT_EQ(cam->dequeue(f, 1000), CameraStatus::kOk);
+  EXPECT_EQ(f.sequence, 3u);
+  EXPECT_EQ(f.timestamp_ns, 5'000'000'000 + 3 * kPeriodNs);
+  ASSERT_FALSE(f.image.empty());
+  EXPECT_EQ(f.image.row8(0)[0], pixel_of(0, 3));
+  ASSERT_EQ(cam->release(f), CameraStatus::kOk);
+  EXPECT_EQ(cam->counters().dropped.get(), 0u);         // a seek is not a camera drop
+  EXPECT_EQ(cam->seek(2), CameraStatus::kUnsupported);  // played already
+  ASSERT_EQ(cam->trigger(), CameraStatus::kOk);
+  ASSERT_EQ(cam->dequeue(f, 1000), CameraStatus::kOk);
+  EXPECT_EQ(f.sequence, 4u);
+  ASSERT_EQ(cam->release(f), CameraStatus::kOk);
+  ASSERT_EQ(cam->seek(99), CameraStatus::kOk);  // past the end
+  EXPECT_EQ(cam->skipped(), 3u);                // frame 5
+  ASSERT_EQ(cam->trigger(), CameraStatus::kOk);
+  EXPECT_EQ(cam->dequeue(f, 0), CameraStatus::kEndOfStream);
 }
 
 TEST_F(ReplayFixture, BufferExhaustionAndBadRelease) {

@@ -4,9 +4,11 @@
 // them. Checked against the same recording replayed in one process: every frame is
 // published and the joint angles (UDP datagrams) are equal within 1e-5 rad; with one node
 // killed mid-run the central goes on publishing from the other node's cameras and ends
-// normally when the replay ends; the node restarted is used again; `mocap record --blobs`
-// of the two nodes tracks to the image recording's poses. Each test uses its own DDS
-// domain id (no cross-talk between concurrent test processes).
+// normally when the replay ends; the node restarted is used again, in step (its replay
+// plays the frame the central's trigger names); with hardware-triggered nodes (the central
+// does not trigger) a killed node's cameras become silent and the sets go on without them;
+// `mocap record --blobs` of the two nodes tracks to the image recording's poses. Each test
+// uses its own DDS domain id (no cross-talk between concurrent test processes).
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -61,9 +63,11 @@ class NodeCluster : public ::testing::Test {
            ::testing::UnitTest::GetInstance()->current_test_info()->name();
     ASSERT_EQ(test::run_command("rm -rf '" + dir_ + "' && mkdir -p '" + dir_ + "'").exit_code, 0);
     // A domain of its own per test process and test (1..231; 0 is left to users).
-    const bool second = std::string(::testing::UnitTest::GetInstance()->current_test_info()->name())
-                            .find("Killed") != std::string::npos;
-    domain_ = 1 + (static_cast<int>(::getpid()) % 115) * 2 + (second ? 1 : 0);
+    const std::string name = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+    const int index = name.find("Killed") != std::string::npos   ? 1
+                      : name.find("Silent") != std::string::npos ? 2
+                                                                 : 0;
+    domain_ = 1 + (static_cast<int>(::getpid()) % 77) * 3 + index;
   }
   void write(const std::string& name, const std::string& text) {
     std::ofstream(dir_ + "/" + name) << text;
@@ -94,6 +98,45 @@ class NodeCluster : public ::testing::Test {
       y += "  - {backend: node, device: n" + std::to_string(c / 4) + "/cam" + std::to_string(c) +
            "}\n";
     write("central.yaml", y + tracker_keys(port, rate_hz));
+  }
+  // The reference: the recording replayed by one process (8 local replay cameras).
+  Published single_process(const test::KeepAllUdpSocket& sock) {
+    std::string single = "cameras:\n";
+    for (int c = 0; c < 8; ++c)
+      single += "  - {backend: replay, device: " + recording() + ", trigger: software}\n";
+    write("single.yaml", single + tracker_keys(sock.port(), 100.0));
+    const test::RunResult one =
+        test::run_mocap("run --config '" + dir_ + "/single.yaml' --stats-interval 0", 120);
+    EXPECT_EQ(one.exit_code, 0) << one.output;
+    return drain(sock);
+  }
+  // Hardware-trigger-like: each node triggers its replay cameras itself at rate_hz
+  // (`trigger: software` on the node: the frames keep the recording's numbers, as cameras
+  // on one trigger line count together) and the central does not trigger (`trigger:
+  // external` on its node cameras), pairing by sequence.
+  void write_external_cluster(int port, double rate_hz, int timeout_ms) {
+    for (int n = 0; n < 2; ++n) {
+      std::string y = "node: {name: n" + std::to_string(n) +
+                      ", domain_id: " + std::to_string(domain_) +
+                      "}\npipeline: {realtime: false, trigger_rate_hz: " + std::to_string(rate_hz) +
+                      "}\ncameras:\n";
+      for (int c = 4 * n; c < 4 * n + 4; ++c)
+        y += "  - {backend: replay, device: " + recording() + ", camera: cam" + std::to_string(c) +
+             ", trigger: software}\n";
+      write("node" + std::to_string(n) + ".yaml", y);
+    }
+    std::string y = "node: {domain_id: " + std::to_string(domain_) +
+                    ", wait_s: 20, timeout_ms: " + std::to_string(timeout_ms) +
+                    "}\nrig: " + recording() + "/rig.yaml\ncameras:\n";
+    for (int c = 0; c < 8; ++c)
+      y += "  - {backend: node, device: n" + std::to_string(c / 4) + "/cam" + std::to_string(c) +
+           ", trigger: external}\n";
+    write("central.yaml",
+          y + "targets: " + recording() + "/targets.yaml\nmodel: " + recording() +
+              "/gt/model_true.yaml\npipeline: {pair_by: sequence, trigger_rate_hz: " +
+              std::to_string(rate_hz) +
+              ", realtime: false, lock_memory: false}\noutputs: {udp: [127.0.0.1:" +
+              std::to_string(port) + "], iceoryx: false}\n");
   }
   // Both nodes in the background, the central in the foreground; `kill_after_s` > 0
   // SIGKILLs node n1 that long after the central started, `restart_after_s` > 0 starts it
@@ -131,15 +174,8 @@ class NodeCluster : public ::testing::Test {
 TEST_F(NodeCluster, TwoNodesPublishEveryFrameWithTheSingleProcessAngles) {
   test::KeepAllUdpSocket single_sock(300'000), nodes_sock(300'000);
   ASSERT_TRUE(single_sock.ok() && nodes_sock.ok());
-  std::string single = "cameras:\n";
-  for (int c = 0; c < 8; ++c)
-    single += "  - {backend: replay, device: " + recording() + ", trigger: software}\n";
-  write("single.yaml", single + tracker_keys(single_sock.port(), 100.0));
-  const test::RunResult one =
-      test::run_mocap("run --config '" + dir_ + "/single.yaml' --stats-interval 0", 120);
-  ASSERT_EQ(one.exit_code, 0) << one.output;
-  const Published ref = drain(single_sock);
-  ASSERT_EQ(static_cast<int>(ref.angles.size()), kFrames) << one.output;
+  const Published ref = single_process(single_sock);
+  ASSERT_EQ(static_cast<int>(ref.angles.size()), kFrames);
 
   write_cluster(nodes_sock.port(), 100.0, 5000);  // no node dies: wait for every frame
   const test::RunResult r = run_cluster(0.0);
@@ -189,6 +225,54 @@ TEST_F(NodeCluster, AKilledNodesCamerasGoMissingComeBackAndTheRunEndsNormally) {
   EXPECT_GT(sent_again, 0) << r.output;
   const long central_frames = std::stol(r.output.substr(at + 21));
   EXPECT_GT(central_frames, sent_again - 3) << r.output;  // a few may come late
+  // The restarted replay followed the central's trigger numbers: it skipped the frames
+  // played before it came back instead of starting at its first frame, and played the
+  // rest up to the end (the frame trigger k names is the recording's k-th).
+  const std::size_t skipped_at = r.output.find(", skipped ", again);
+  ASSERT_NE(skipped_at, std::string::npos) << r.output;
+  const long skipped = std::stol(r.output.substr(skipped_at + 10));
+  EXPECT_GT(skipped, 0) << r.output;
+  EXPECT_GE(sent_again + skipped, kFrames - 1) << r.output;
+  EXPECT_LE(sent_again + skipped, kFrames) << r.output;
+  // In step: the last frame (all 8 cameras again) has the one-process angles.
+  test::KeepAllUdpSocket single_sock(300'000);
+  ASSERT_TRUE(single_sock.ok());
+  const Published ref = single_process(single_sock);
+  ASSERT_FALSE(ref.angles.empty());
+  ASSERT_FALSE(got.angles.empty());
+  const auto& [last_ns, last] = *ref.angles.rbegin();
+  ASSERT_EQ(got.angles.rbegin()->first, last_ns) << r.output;
+  const std::vector<float>& mine = got.angles.rbegin()->second;
+  ASSERT_EQ(mine.size(), last.size());
+  for (std::size_t i = 0; i < last.size(); ++i) {
+    if (std::isnan(last[i])) continue;
+    EXPECT_NEAR(mine[i], last[i], 1e-5) << "angle " << i << "\n" << r.output;
+  }
+}
+
+// Hardware-triggered nodes (the central does not trigger): node n1 killed mid-run. Its
+// cameras become silent after node.timeout_ms + a trigger period, the sets go on from
+// node n0's cameras (counted in frames_without_silent_cameras), and the run ends when
+// n0's replay ends. Before issue 29's fix the sets waited for n1 forever (no frame
+// published after the kill, the run never ended: timeout).
+TEST_F(NodeCluster, ASilentHardwareTriggeredNodeDoesNotStallTheFrameSets) {
+  test::KeepAllUdpSocket sock(300'000);
+  ASSERT_TRUE(sock.ok());
+  write_external_cluster(sock.port(), 5.0, 300);  // 30 frames at 5 Hz: 6 s; bound 0.5 s
+  const test::RunResult r = run_cluster(3.5);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("the recording ended"), std::string::npos) << r.output;
+  auto counter = [&](const std::string& name) -> long {
+    const std::size_t at = r.output.find(" " + name + "=");
+    return at == std::string::npos ? -1 : std::stol(r.output.substr(at + name.size() + 2));
+  };
+  const long partial = counter("frames_without_silent_cameras");
+  EXPECT_GE(partial, 3) << r.output;  // the frames after the kill (n0 went on ~2 s)
+  EXPECT_EQ(counter("pair_silent_cam4"), 1) << r.output;
+  EXPECT_EQ(counter("pair_silent_cam0"), 0) << r.output;
+  EXPECT_EQ(counter("pair_absent_cam7"), partial) << r.output;
+  const Published got = drain(sock);
+  EXPECT_GE(got.datagrams, partial + 3) << r.output;  // full sets before the kill too
 }
 
 // `mocap record --blobs` takes node cameras: the blob recording of the two nodes tracks

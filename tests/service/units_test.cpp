@@ -67,6 +67,10 @@ TEST(SystemdUnits, ServiceSettings) {
         "SupplementaryGroups=video\n", "LimitRTPRIO=", "LimitMEMLOCK=infinity\n",
         "CPUAffinity=", "StateDirectory=mocap\n", "LogsDirectory=mocap\n", "--check-config"})
     EXPECT_NE(m.find(line), std::string::npos) << "mocap.service lacks " << line;
+  // The node's unit validates its configuration first, as mocap.service does.
+  EXPECT_NE(read_file(source_dir() + "/deploy/mocap-node.service.in")
+                .find("\nExecStartPre=@MOCAP_BINDIR@/mocap node --check-config "),
+            std::string::npos);
   // The CPU latency request (pipeline.cpu_latency_us): the device is allowed in the unit's
   // closed device policy, and the udev rule gives it to the service's group.
   EXPECT_NE(m.find("\nDeviceAllow=/dev/cpu_dma_latency rw\n"), std::string::npos);
