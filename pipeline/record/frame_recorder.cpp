@@ -63,6 +63,7 @@ Expected<std::unique_ptr<FrameRecorder>> FrameRecorder::create(const RecorderOpt
   pc.tolerance = o.pair_by == pipeline::PairBy::kSequence ? 0 : o.pair_tolerance_ns;
   pc.max_pending = o.slots_per_camera;
   pc.cameras = n;
+  pc.silent_after_ns = o.silent_after_ns;
   auto pairer = hal::FramePairer::create(pc);
   if (!pairer) return pairer.error();
   r->pairer_.emplace(std::move(pairer).value());
@@ -230,16 +231,6 @@ void FrameRecorder::free_slot(int camera, std::int32_t slot) noexcept {
   (void)free_[c]->try_push(static_cast<std::uint32_t>(slot));
 }
 
-Expected<void> FrameRecorder::write_blobs(int camera, std::int64_t number, const Slot& s) {
-  auto r = blob_files_[static_cast<std::size_t>(camera)].append(number, s.timestamp_ns, s.blobs);
-  if (!r) return r;
-  blob_lists_written_.add();
-  if (s.kept < 0) return {};
-  r = files_.write_image(camera, number, s.view);
-  if (r) images_written_.add();
-  return r;
-}
-
 bool FrameRecorder::drain(bool flush) {
   bool got = false;
   auto on_drop = [this](int camera, const hal::PairEntry& e) {
@@ -249,6 +240,17 @@ bool FrameRecorder::drain(bool flush) {
     units_.push_back(u);
   };
   const int n = camera_count();
+  hal::FramePair pair;
+  auto take = [&] {  // a silent camera's entry (kAbsentHandle): no slot
+    Unit u;
+    for (int k = 0; k < n; ++k) {
+      const std::uint32_t h = pair.cam[k].handle;
+      u.slot[k] = h == hal::kAbsentHandle ? -1 : static_cast<std::int32_t>(h);
+      if (u.slot[k] >= 0) u.frame = slots_[static_cast<std::size_t>(k)][h].frame;
+    }
+    units_.push_back(u);
+  };
+  const std::int64_t now = hal::monotonic_ns();
   for (int c = 0; c < n; ++c) {
     std::uint32_t index = 0;
     while (filled_[static_cast<std::size_t>(c)]->try_pop(index)) {
@@ -257,97 +259,12 @@ bool FrameRecorder::drain(bool flush) {
       const std::int64_t key = options_.pair_by == pipeline::PairBy::kSequence
                                    ? static_cast<std::int64_t>(s.sequence)
                                    : s.timestamp_ns;
-      hal::FramePair pair;
-      if (pairer_->push(c, hal::PairEntry{key, index}, pair, on_drop)) {
-        Unit u;
-        for (int k = 0; k < n; ++k) u.slot[k] = static_cast<std::int32_t>(pair.cam[k].handle);
-        u.frame = slots_[0][pair.cam[0].handle].frame;
-        units_.push_back(u);
-      }
+      if (pairer_->push(c, hal::PairEntry{key, index}, pair, on_drop, now)) take();
     }
   }
-  if (flush) pairer_->flush(on_drop);  // the frames whose partner never came
+  while (pairer_->expire(now, pair)) take();  // sets that waited out a silent camera
+  if (flush) pairer_->flush(on_drop);         // the frames whose partner never came
   return got;
-}
-
-void FrameRecorder::write_unit(const Unit& u) {
-  const bool skip = error_.has_value() || u.frame <= last_frame_;
-  if (!skip) {
-    // Recordings number their frames from 0: the first frame written is frame 0 (the
-    // same as the tap's numbering unless every image of the first frames was dropped).
-    if (first_frame_ < 0) first_frame_ = u.frame;
-    const std::int64_t number = u.frame - first_frame_;
-    const int n = camera_count();
-    int written[kMaxCameras] = {-1, -1, -1, -1, -1, -1, -1, -1};
-    bool has[kMaxCameras] = {};  // the camera's image (or blob list) is in the recording
-    Expected<void> r;
-    for (int c = 0; c < n && r; ++c) {
-      if (u.slot[c] < 0) continue;
-      const Slot& s = slots_[static_cast<std::size_t>(c)][static_cast<std::size_t>(u.slot[c])];
-      if (s.missing) continue;
-      if (options_.blobs) {  // its chunk stays if the row fails: not in frames.csv, never read
-        r = write_blobs(c, number, s);
-        if (r && s.kept >= 0) written[c] = c;
-        has[c] = static_cast<bool>(r);
-        continue;
-      }
-      r = files_.write_image(c, number, s.view);
-      if (r) written[c] = c;
-      has[c] = static_cast<bool>(r);
-    }
-    int ts_cam = 0;  // the first camera with an image slot gives the timestamp
-    while (ts_cam + 1 < n && u.slot[ts_cam] < 0) ++ts_cam;
-    const Slot& ts =
-        slots_[static_cast<std::size_t>(ts_cam)][static_cast<std::size_t>(u.slot[ts_cam])];
-    if (r) r = files_.append_row(number, ts.timestamp_ns);
-    if (!r) {  // the frame is not in frames.csv: its files go too
-      for (int c : written)
-        if (c >= 0) files_.remove_image(c, number);
-      error_ = r.error();
-      failed_.store(true, std::memory_order_release);  // pairs with failed()'s acquire
-      not_written_.add();
-    } else {
-      last_frame_ = u.frame;
-      frames_written_.add();
-      for (int c = 0; c < n; ++c)
-        if (!has[c]) without_image_[static_cast<std::size_t>(c)].add();
-      if (!options_.blobs)
-        for (int c : written)
-          if (c >= 0) images_written_.add();
-      std::uint64_t bytes = files_.bytes_written();
-      for (const BlobFileWriter& w : blob_files_) bytes += w.bytes();
-      bytes_written_.add(bytes - bytes_written_.get());
-    }
-  } else {
-    not_written_.add();
-  }
-  for (int c = 0; c < camera_count(); ++c) free_slot(c, u.slot[c]);
-}
-
-void FrameRecorder::write_units() {
-  std::sort(units_.begin(), units_.end(),
-            [](const Unit& a, const Unit& b) { return a.frame < b.frame; });
-  // The cameras of one frame dropped by the matcher one by one (a camera missed the
-  // frame) arrive as units of one camera each: merged into one unit per frame.
-  std::size_t out = 0;
-  for (std::size_t i = 0; i < units_.size(); ++i) {
-    if (out > 0 && units_[out - 1].frame == units_[i].frame) {
-      Unit& m = units_[out - 1];
-      for (int c = 0; c < kMaxCameras; ++c) {
-        if (m.slot[c] < 0) {
-          m.slot[c] = units_[i].slot[c];
-        } else if (units_[i].slot[c] >= 0) {  // the same camera twice: cannot happen
-          free_slot(c, units_[i].slot[c]);
-          not_written_.add();
-        }
-      }
-    } else {
-      units_[out++] = units_[i];
-    }
-  }
-  units_.resize(out);
-  for (const Unit& u : units_) write_unit(u);
-  units_.clear();
 }
 
 void FrameRecorder::writer_loop() {

@@ -62,6 +62,10 @@ struct RecorderOptions {
   int wait_for_slot_ms = 0;               // > 0 only in lockstep pacing
   pipeline::PairBy pair_by = pipeline::PairBy::kSequence;
   std::int64_t pair_tolerance_ns = 1'000'000;
+  // Per camera: how long (ns) the others' frames wait for it before it is silent and the
+  // frames are written without it (hal::FramePairer; camera nodes the central does not
+  // trigger: PipelineOptions::silent_after_ns). 0: always waited for.
+  std::array<std::int64_t, kMaxCameras> silent_after_ns{};
   std::uint64_t byte_budget =
       0;               // test hook: ENOSPC past this many bytes (0: off; blobs: per file)
   bool blobs = false;  // blob lists (on_blobs) instead of images (on_frame)

@@ -168,6 +168,7 @@ int record(const RecordArgs& a) {
   ro.wait_for_slot_ms = lockstep ? 1000 : 0;  // lockstep records every frame
   ro.pair_by = opt.pair_by;
   ro.pair_tolerance_ns = opt.pair_tolerance_us * 1000;
+  ro.silent_after_ns = opt.silent_after_ns;  // a silent hardware-triggered node: go on
   ro.blobs = a.blobs;
   ro.max_blobs = static_cast<std::uint32_t>(cfg->tracker.detect.max_blobs);
   ro.keep_images_every = static_cast<std::uint32_t>(a.keep_images);

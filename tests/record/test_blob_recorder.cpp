@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <chrono>
 #include <filesystem>
 #include <thread>
 
@@ -155,6 +156,61 @@ TEST(BlobRecorder, WritesEveryBlobListAndTheKeptImagesFromTheDetectThreads) {
         EXPECT_TRUE(std::equal(im.data(), im.data() + im.size_bytes(), expect.data()));
       }
     }
+  }
+}
+
+// A hardware-triggered camera node that goes silent (camera 1 never delivers): after
+// its silent_after_ns bound the frames are written without it, each counted in
+// without_image, instead of waiting for it until every slot is taken and then dropping
+// the frames of the cameras that do deliver.
+TEST(BlobRecorder, ASilentCameraDoesNotStallTheRecording) {
+  test::TempDir dir("rec_blobs_silent");
+  write_blob_rig(dir.path());
+  RecorderOptions o;
+  o.dir = dir.path();
+  o.camera_names = {"cam0", "cam1"};
+  o.cameras = {CameraGeometry{kBlobW, kBlobH, PixelFormat::kMono8},
+               CameraGeometry{kBlobW, kBlobH, PixelFormat::kMono8}};
+  o.slots_per_camera = 16;
+  o.blobs = true;
+  o.max_blobs = 8;
+  o.silent_after_ns[1] = 10'000'000;  // 10 ms: 5 frame periods of 2 ms
+  auto rec = FrameRecorder::create(o);
+  ASSERT_TRUE(rec) << rec.error().message;
+  (*rec)->start();
+  constexpr std::uint64_t kFrames = 40;
+  detect::BlobList list(8);
+  Image image = blob_test_image(0, 0);
+  for (std::uint64_t f = 0; f < kFrames; ++f) {
+    hal::Frame fr;
+    fr.image = image.view();
+    fr.sequence = 100 + f;
+    fr.timestamp_ns = 1'000'000'000 + static_cast<std::int64_t>(f) * 2'000'000;
+    blobs_of(0, static_cast<std::int64_t>(f), list);
+    (*rec)->on_frame(0, fr);
+    (*rec)->on_blobs(0, fr, true, list);
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  ASSERT_TRUE((*rec)->finish());
+  const RecorderCounts k = (*rec)->counts();
+  EXPECT_EQ(k.frames_written, kFrames);
+  EXPECT_EQ(k.dropped[0], 0u);
+  EXPECT_EQ(k.without_image[0], 0u);
+  EXPECT_EQ(k.without_image[1], kFrames);
+  auto r = Recording::open(dir.path());
+  ASSERT_TRUE(r) << r.error().message;
+  ASSERT_EQ(r->frames().size(), kFrames);
+  detect::BlobList got(8);
+  std::vector<std::uint8_t> scratch;
+  for (std::uint64_t f = 0; f < kFrames; ++f) {
+    const auto n = static_cast<std::int64_t>(f);
+    auto c0 = r->load_blobs(0, n, got, scratch);
+    ASSERT_TRUE(c0) << c0.error().message;
+    EXPECT_EQ(*c0, FrameLoad::kOk) << f;
+    EXPECT_EQ(got.size(), static_cast<std::size_t>(f % 5)) << f;
+    auto c1 = r->load_blobs(1, n, got, scratch);
+    ASSERT_TRUE(c1) << c1.error().message;
+    EXPECT_EQ(*c1, FrameLoad::kMissing) << f;
   }
 }
 
