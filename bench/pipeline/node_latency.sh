@@ -1,0 +1,64 @@
+#!/usr/bin/env bash
+# Camera nodes on loopback (issue 29): what two `mocap node` processes add to the
+# trigger-to-publish latency of the same recording tracked in one process.
+#   (a) one process: `mocap run` with the recording's 8 cameras as local replay cameras;
+#   (b) two nodes of 4 replay cameras each (`trigger: central`) and a central `mocap run`
+#       with 8 `backend: node` cameras;
+# both `pipeline: {pacing: lockstep}` at 100 Hz, so every frame of the recording is
+# published, and both print `publish (end to end)` (p50, p99, p99.9, max in us): in (a)
+# from the replay's delivery of the frame, in (b) from the central trigger (the trigger's
+# way to the node, the node's replay and detection, the blob message's way back).
+# The central's report also splits (b) into its legs (`nodes:` lines).
+# Usage: bash bench/pipeline/node_latency.sh [MOCAP] REC [OUT] [RUNS] [REALTIME]
+#   REC: an 8-camera recording with targets.yaml and gt/model_true.yaml, e.g.
+#        `mocap simulate --scene humanoid --cameras 8 --frames 200 --out REC`;
+#   defaults: build/mocap, -, /tmp/node_latency, 3 runs, realtime false.
+# docs/performance.md records the figures with the machine.
+set -euo pipefail
+mocap=$(realpath "${1:-build/mocap}")
+rec=$(realpath "$2")
+out=${3:-/tmp/node_latency}
+runs=${4:-3}
+realtime=${5:-false}
+domain=$((100 + $$ % 100))
+mkdir -p "$out"
+
+tracker_keys() {
+  printf 'targets: %s/targets.yaml\nmodel: %s/gt/model_true.yaml\n' "$rec" "$rec"
+  printf 'pipeline: {pacing: lockstep, trigger_rate_hz: 100, realtime: %s}\n' "$realtime"
+  printf 'outputs: {iceoryx: false}\n'
+}
+
+{
+  echo "cameras:"
+  for c in 0 1 2 3 4 5 6 7; do echo "  - {backend: replay, device: $rec, trigger: software}"; done
+  tracker_keys
+} >"$out/single.yaml"
+for n in 0 1; do
+  {
+    printf 'node: {name: n%s, domain_id: %s}\npipeline: {realtime: %s}\ncameras:\n' "$n" "$domain" "$realtime"
+    for c in $((4 * n)) $((4 * n + 1)) $((4 * n + 2)) $((4 * n + 3)); do
+      echo "  - {backend: replay, device: $rec, camera: cam$c, trigger: central}"
+    done
+  } >"$out/node$n.yaml"
+done
+{
+  printf 'node: {domain_id: %s, wait_s: 20, timeout_ms: 2000}\nrig: %s/rig.yaml\ncameras:\n' "$domain" "$rec"
+  for c in 0 1 2 3 4 5 6 7; do echo "  - {backend: node, device: n$((c / 4))/cam$c}"; done
+  tracker_keys
+} >"$out/central.yaml"
+
+e2e() { grep -E "publish \(end to end\)|^run:" "$1" | tr -s ' '; }
+for r in $(seq 1 "$runs"); do
+  "$mocap" run --config "$out/single.yaml" --stats-interval 0 >"$out/single$r.txt" 2>&1
+  echo "(a) one process, run $r: $(e2e "$out/single$r.txt" | tr '\n' ' ')"
+  "$mocap" node --config "$out/node0.yaml" >"$out/node0_$r.txt" 2>&1 &
+  n0=$!
+  "$mocap" node --config "$out/node1.yaml" >"$out/node1_$r.txt" 2>&1 &
+  n1=$!
+  "$mocap" run --config "$out/central.yaml" --stats-interval 0 >"$out/central$r.txt" 2>&1 || true
+  kill "$n0" "$n1" 2>/dev/null || true
+  wait "$n0" "$n1" 2>/dev/null || true
+  echo "(b) two nodes + central, run $r: $(e2e "$out/central$r.txt" | tr '\n' ' ')"
+  grep -E "^ *nodes|transit|trigger ->|-> central" "$out/central$r.txt" | head -n 6 || true
+done
