@@ -6,21 +6,34 @@
 // least min(fx, fy) * sin(phi) (normalised distance >= sin(phi) since |(x, y, 1)| >= 1).
 // So d_a <= tol implies |sin(theta - theta')| <= tol / (min(fx, fy) * rho): with theta
 // taken modulo pi, a window of half-width asin(that) around theta contains every pair
-// within tolerance; the exact symmetric test then decides.
+// within tolerance; the exact symmetric test then decides. The angles are compared as
+// pseudo-angles (plane_key, monotone in theta), the window's ends found by turning the
+// plane's direction by that half-width (its sine and cosine: no trigonometric call).
 #include "stereo/stereo_triangulator.h"
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 #include <string>
 #include <utility>
 
 namespace mocap {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
-
 bool finite(double v) { return std::isfinite(v); }
+
+// The plane of direction (p, q) about the baseline, taken modulo pi (a plane, not a
+// half-plane), as a pseudo-angle in [0, 2): q / (p + q) over [0, pi/2], 1 + |p| / (|p| +
+// q) over (pi/2, pi) after folding q >= 0; monotone in the angle, so it sorts and bounds
+// windows exactly as the angle does. The zero vector (a ray along the baseline) is 0.
+double plane_key(double p, double q) noexcept {
+  if (q < 0.0 || (q == 0.0 && p < 0.0)) {
+    p = -p;
+    q = -q;
+  }
+  const double sum = std::abs(p) + q;
+  if (!(sum > 0.0)) return 0.0;
+  return p >= 0.0 ? q / sum : 1.0 + -p / sum;
+}
 
 }  // namespace
 
@@ -85,8 +98,8 @@ void StereoTriangulator::prepare(const UndistortedBlobs& blobs, int n, int camer
     Observation& o = obs[static_cast<std::size_t>(i)];
     o.px = blobs.px[i];
     o.valid = false;
-    o.theta = 0.0;
-    o.window = kPi;
+    o.key = 0.0;
+    o.whole = true;
     if (blobs.valid[i] == 0) {  // not finite, or the undistortion failed
       ++counters_.undistort_failed[static_cast<std::size_t>(camera)];
       continue;
@@ -94,21 +107,29 @@ void StereoTriangulator::prepare(const UndistortedBlobs& blobs, int n, int camer
     const Vec2& xn = blobs.xn[i];
     o.valid = true;
     o.s = to_scaled(cam, xn);
-    // Unit ray in camera-a coordinates.
+    // The ray in camera-a coordinates (its length does not change the plane).
     Vec3 r(xn.x(), xn.y(), 1.0);
-    if (camera == 1) r = geometry_.R_10.transpose() * r;
+    if (camera == 1) {  // camera b's blobs are only searched: no window
+      r = geometry_.R_10.transpose() * r;
+      o.key = plane_key(r.dot(plane_u_0_), r.dot(plane_v_0_));
+      continue;
+    }
     r.normalize();
     const double p = r.dot(plane_u_0_);
     const double q = r.dot(plane_v_0_);
-    double theta = std::atan2(q, p);
-    if (theta < 0.0) theta += kPi;
-    if (theta >= kPi) theta -= kPi;
-    o.theta = theta;
-    if (camera == 1) continue;  // camera b's blobs are only searched: no window
+    o.key = plane_key(p, q);
     const double rho = std::hypot(p, q);
-    // Safety margin for rounding: the window only has to be conservative.
+    // Safety margins for rounding: the window only has to be conservative (its sine
+    // widened, and once more for the rotation and the keys' own rounding).
     const double s = config_.epipolar_tolerance_px * (1.0 + 1e-9) / (f_min * rho) + 1e-12;
-    o.window = s >= 1.0 || !finite(s) ? kPi : std::asin(s) + 1e-12;
+    const double sw = s * (1.0 + 1e-9) + 1e-12;
+    if (!(sw < 1.0) || !finite(sw)) continue;  // the whole pencil
+    o.whole = false;
+    // The window's ends: the plane's direction (p, q) / rho turned by -w and +w, sin w = sw.
+    const double cw = std::sqrt(1.0 - sw * sw);
+    const double up = p / rho, uq = q / rho;
+    o.lo = plane_key(up * cw + uq * sw, uq * cw - up * sw);
+    o.hi = plane_key(up * cw - uq * sw, uq * cw + up * sw);
   }
 }
 
@@ -173,8 +194,8 @@ void StereoTriangulator::scan_range(int i, double lo, double hi, PointList& out,
   const SortKey* first = keys_b_.data();
   const SortKey* last = first + n_b_;
   const SortKey* it =
-      std::lower_bound(first, last, lo, [](const SortKey& k, double v) { return k.theta < v; });
-  for (; it != last && it->theta <= hi; ++it) try_pair(i, it->index, out, capacity);
+      std::lower_bound(first, last, lo, [](const SortKey& k, double v) { return k.key < v; });
+  for (; it != last && it->key <= hi; ++it) try_pair(i, it->index, out, capacity);
 }
 
 bool StereoTriangulator::process(const Vec2* px_a, int n_a, const Vec2* px_b, int n_b,
@@ -228,26 +249,21 @@ bool StereoTriangulator::process(const UndistortedBlobs& a, const UndistortedBlo
     int k = 0;
     for (int j = 0; j < n_b; ++j) {
       const Observation& o = obs_b_[static_cast<std::size_t>(j)];
-      if (o.valid) keys_b_[static_cast<std::size_t>(k++)] = SortKey{o.theta, j};
+      if (o.valid) keys_b_[static_cast<std::size_t>(k++)] = SortKey{o.key, j};
     }
     n_b_ = k;
     std::sort(keys_b_.begin(), keys_b_.begin() + k,
-              [](const SortKey& x, const SortKey& y) { return x.theta < y.theta; });
+              [](const SortKey& x, const SortKey& y) { return x.key < y.key; });
     for (int i = 0; i < n_a; ++i) {
       const Observation& o = obs_a_[static_cast<std::size_t>(i)];
       if (!o.valid) continue;
-      const double lo = o.theta - o.window;
-      const double hi = o.theta + o.window;
-      if (o.window >= 0.5 * kPi) {
+      if (o.whole) {
         scan_range(i, -1.0, 4.0, out, capacity);  // the whole pencil
-      } else if (lo < 0.0) {
-        scan_range(i, 0.0, hi, out, capacity);
-        scan_range(i, lo + kPi, kPi, out, capacity);
-      } else if (hi >= kPi) {
-        scan_range(i, lo, kPi, out, capacity);
-        scan_range(i, 0.0, hi - kPi, out, capacity);
+      } else if (o.lo > o.hi) {                   // through 0 (= pi): both ends of the keys
+        scan_range(i, 0.0, o.hi, out, capacity);
+        scan_range(i, o.lo, 2.0, out, capacity);
       } else {
-        scan_range(i, lo, hi, out, capacity);
+        scan_range(i, o.lo, o.hi, out, capacity);
       }
     }
   }

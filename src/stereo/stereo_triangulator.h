@@ -11,8 +11,9 @@
 //   blob index per camera, and candidates sharing a blob with another are flagged
 //   `ambiguous`. Nothing is silently dropped except for capacity, which is counted.
 //   Search: the blobs of camera b are sorted by the angle of their epipolar plane about
-//   the baseline; a blob of camera a only visits the b-blobs whose plane angle lies in
-//   a window that provably contains every pair within tolerance, O((n+m) log m + k).
+//   the baseline (a pseudo-angle, monotone in it: no trigonometry per blob); a blob of
+//   camera a only visits the b-blobs whose plane angle lies in a window that provably
+//   contains every pair within tolerance, O((n+m) log m + k).
 //   MatchMethod::kExhaustive (all n*m pairs) gives the same set; kept for testing and
 //   benchmarks.
 // Capacity is fixed in create(); process() is noexcept and allocation-free. Failures
@@ -112,14 +113,17 @@ class StereoTriangulator {
 
  private:
   struct Observation {
-    Vec2 px;        // distorted pixels (input)
-    Vec2 s;         // pixel-scaled undistorted coordinates (fx x', fy y')
-    double theta;   // epipolar plane angle about the baseline, [0, pi)
-    double window;  // half-width of the plane-angle window (camera a only)
+    Vec2 px;     // distorted pixels (input)
+    Vec2 s;      // pixel-scaled undistorted coordinates (fx x', fy y')
+    double key;  // the epipolar plane's angle about the baseline as a pseudo-angle
+    // Camera a only: the window of keys [lo, hi] (lo > hi: it wraps through 0, i.e.
+    // [0, hi] and [lo, 2]); whole: every plane (the blob's ray is near the baseline).
+    double lo, hi;
+    bool whole;
     bool valid;
   };
   struct SortKey {
-    double theta;
+    double key;
     int index;
   };
 
