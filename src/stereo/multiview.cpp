@@ -15,6 +15,9 @@ namespace {
 // 3 steps gave the same RMSE as 10 on the 4-camera ring of tests/stereo/test_multiview.cpp
 // (0.1416 mm, MULTIVIEW_VERBOSE=1), and cut the merge's time (docs/performance.md).
 constexpr int kRefineIterations = 3;
+// A step below this ends the refinement: a thousandth of a marker's 3D noise (0.1 mm and
+// more at these ranges), so stopping there moves no point measurably.
+constexpr double kStepToleranceMm = 1e-4;
 }  // namespace
 
 Expected<MultiViewMerger> MultiViewMerger::create(const Rig& rig, const MultiViewConfig& config) {
@@ -123,7 +126,7 @@ void MultiViewMerger::refine(int i, const Vec2* const* px) noexcept {
     if (k < 3) return;  // two views: the pair's optimal (niter2) point stands
     Vec3 X = h.X_world;
     double rms = 0.0;
-    if (!refine_gauss_newton(cams, obs, k, X, rms, kRefineIterations)) return;
+    if (!refine_gauss_newton(cams, obs, k, X, rms, kRefineIterations, kStepToleranceMm)) return;
     int worst = -1;
     double worst_d = config_.gate_px;
     for (int v = 0; v < k; ++v) {
@@ -219,7 +222,8 @@ bool MultiViewMerger::refit(Point3& p, const Vec2* const* px) const noexcept {
   Vec3 X = p.X_world;
   double rms = 0.0;
   // From a point the dropped view pulled by at most the gate: a few steps converge.
-  if (!refine_gauss_newton(cams, obs, k, X, rms, 2 * kRefineIterations)) return false;
+  if (!refine_gauss_newton(cams, obs, k, X, rms, 2 * kRefineIterations, kStepToleranceMm))
+    return false;
   p.X_world = X;
   p.reproj_px = rms;
   return true;

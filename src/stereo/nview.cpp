@@ -77,7 +77,7 @@ inline bool residual(const CameraModel& cam, const Vec3& X, const Vec2& obs, Vec
 }  // namespace
 
 bool refine_gauss_newton(const CameraModel* const* cams, const Vec2* px, int n, Vec3& X_world,
-                         double& rms_px, int max_iterations) noexcept {
+                         double& rms_px, int max_iterations, double step_tolerance_mm) noexcept {
   if (n < 1 || n > kMaxCameras) return false;
   Vec3 X = X_world;
   bool last = max_iterations <= 0;
@@ -123,7 +123,7 @@ bool refine_gauss_newton(const CameraModel* const* cams, const Vec2* px, int n, 
     if (!step.allFinite()) break;
     X -= step;
     // After a converged step (or the last allowed one) evaluate once more and stop.
-    last = step.norm() < 1e-9 || it + 1 >= max_iterations;
+    last = step.norm() < step_tolerance_mm || it + 1 >= max_iterations;
   }
   return true;
 }

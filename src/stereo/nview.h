@@ -17,9 +17,10 @@ bool triangulate_linear_nview(const CameraModel* const* cams, const Vec2* xn, in
                               Vec3& X_world) noexcept;
 
 // Minimises sum_k |project(cams[k], X) - px[k]|^2 starting from X_world (in/out).
-// Stops when the step is below 1e-9 mm or after max_iterations. Writes the final RMS
-// reprojection error (px). Returns false when a camera sees the point behind it.
+// Stops when a step is below step_tolerance_mm or after max_iterations. Writes the final
+// RMS reprojection error (px). Returns false when a camera sees the point behind it.
 bool refine_gauss_newton(const CameraModel* const* cams, const Vec2* px, int n, Vec3& X_world,
-                         double& rms_px, int max_iterations = 10) noexcept;
+                         double& rms_px, int max_iterations = 10,
+                         double step_tolerance_mm = 1e-9) noexcept;
 
 }  // namespace mocap
