@@ -30,17 +30,9 @@ bool project(const CameraModel& cam, const Vec3& X_world, Vec2& px) noexcept {
 
 bool project(const CameraModel& cam, const Vec3& X_world, Vec2& px,
              Eigen::Matrix<double, 2, 3>& J_px_X) noexcept {
-  const Vec3 Xc = cam.R_cam_world * X_world + cam.t_cam_world;
-  if (!(Xc.z() > 1e-9)) return false;
-  const double iz = 1.0 / Xc.z();
-  const Vec2 xn(Xc.x() * iz, Xc.y() * iz);
-  px = normalized_to_pixel(cam, xn);
-  Eigen::Matrix<double, 2, 3> J_xn_Xc;
-  J_xn_Xc << iz, 0.0, -xn.x() * iz, 0.0, iz, -xn.y() * iz;
-  Eigen::Matrix2d F = Eigen::Matrix2d::Zero();
-  F(0, 0) = cam.fx;
-  F(1, 1) = cam.fy;
-  J_px_X = F * distort_jacobian(cam, xn) * J_xn_Xc * cam.R_cam_world;
+  double J[6];
+  if (!project_jacobian(cam, X_world, px, J)) return false;
+  J_px_X << J[0], J[1], J[2], J[3], J[4], J[5];
   return true;
 }
 

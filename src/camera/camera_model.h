@@ -61,6 +61,37 @@ bool project(const CameraModel& cam, const Vec3& X_world, Vec2& px) noexcept;
 // Same, with the 2x3 Jacobian d(px)/d(X_world).
 bool project(const CameraModel& cam, const Vec3& X_world, Vec2& px,
              Eigen::Matrix<double, 2, 3>& J_px_X) noexcept;
+// The same projection and, when J is non-null, the same Jacobian as a row-major 2x3 array
+// (J[0..2]: d(u)/d(X), J[3..5]: d(v)/d(X)): the distortion's 2x2 Jacobian times the
+// pinhole's 2x3 times R, written out with no temporaries. Inline for the N-view merge's
+// Gauss-Newton loop; project() above is this one.
+inline bool project_jacobian(const CameraModel& cam, const Vec3& X_world, Vec2& px,
+                             double* J) noexcept {
+  const Mat3& R = cam.R_cam_world;
+  const Vec3 Xc = R * X_world + cam.t_cam_world;
+  if (!(Xc.z() > 1e-9)) return false;
+  const double iz = 1.0 / Xc.z();
+  const double x = Xc.x() * iz, y = Xc.y() * iz;
+  const auto& d = cam.distortion;
+  const double r2 = x * x + y * y;
+  const double radial = 1.0 + r2 * (d[0] + r2 * (d[1] + r2 * d[4]));
+  px = Vec2(cam.fx * (x * radial + 2.0 * d[2] * x * y + d[3] * (r2 + 2.0 * x * x)) + cam.cx,
+            cam.fy * (y * radial + d[2] * (r2 + 2.0 * y * y) + 2.0 * d[3] * x * y) + cam.cy);
+  if (J == nullptr) return true;
+  const double dradial = d[0] + r2 * (2.0 * d[1] + 3.0 * r2 * d[4]);  // d(radial)/d(r2)
+  const double fxz = cam.fx * iz, fyz = cam.fy * iz;
+  const double a00 = fxz * (radial + 2.0 * x * x * dradial + 2.0 * d[2] * y + 6.0 * d[3] * x);
+  const double a01 = fxz * (2.0 * x * y * dradial + 2.0 * d[2] * x + 2.0 * d[3] * y);
+  const double a10 = fyz * (2.0 * x * y * dradial + 2.0 * d[2] * x + 2.0 * d[3] * y);
+  const double a11 = fyz * (radial + 2.0 * y * y * dradial + 6.0 * d[2] * y + 2.0 * d[3] * x);
+  // d(px)/d(Xc) = [a00 a01 -(a00 x + a01 y); a10 a11 -(a10 x + a11 y)], then times R.
+  const double b02 = -(a00 * x + a01 * y), b12 = -(a10 * x + a11 * y);
+  for (int c = 0; c < 3; ++c) {
+    J[c] = a00 * R(0, c) + a01 * R(1, c) + b02 * R(2, c);
+    J[3 + c] = a10 * R(0, c) + a11 * R(1, c) + b12 * R(2, c);
+  }
+  return true;
+}
 
 // Pixel -> normalised undistorted coordinates (x', y'): inverts the distortion by
 // Gauss-Newton started from the fixed-point estimate; converges to < 1e-12 over the

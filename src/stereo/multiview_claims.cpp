@@ -42,9 +42,11 @@ double MultiViewMerger::claim_margin_mm(int c, int v, const Vec3& X, int& unfit)
   const double z = (cam.R_cam_world * X + cam.t_cam_world).z();
   if (!(z > 1e-9)) return v < 0 && z < 0.0 ? 0.5 * -z : 0.0;  // behind: extension skips it
   Vec2 q;
-  Eigen::Matrix<double, 2, 3> J;
-  if (!project(cam, X, q, J)) return 0.0;
-  const double L = J.norm();
+  double J[6];
+  if (!project_jacobian(cam, X, q, J)) return 0.0;
+  double L2 = 0.0;  // the Jacobian's Frobenius norm, squared
+  for (const double j : J) L2 += j * j;
+  const double L = std::sqrt(L2);
   if (!(L > 0.0) || !std::isfinite(L)) return 0.0;
   const double gate = config_.gate_px;
   const double wide = std::max(gate, unfit_gate_px(c, X));

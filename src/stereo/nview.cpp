@@ -37,45 +37,6 @@ bool triangulate_linear_nview(const CameraModel* const* cams, const Vec2* xn, in
   return true;
 }
 
-namespace {
-
-// The residual project(cam, X) - obs (real pixels) and, when J is non-null, its 2x3
-// Jacobian d(px)/d(X_world): the chain of project()'s, written out (pixels from the
-// distortion's 2x2 Jacobian times the pinhole's 2x3 times R) with no temporaries. False
-// when the point is not in front of the camera (as project()).
-inline bool residual(const CameraModel& cam, const Vec3& X, const Vec2& obs, Vec2& r,
-                     double* J) noexcept {
-  const Mat3& R = cam.R_cam_world;
-  const Vec3 Xc = R * X + cam.t_cam_world;
-  if (!(Xc.z() > 1e-9)) return false;
-  const double iz = 1.0 / Xc.z();
-  const double x = Xc.x() * iz, y = Xc.y() * iz;
-  const auto& d = cam.distortion;
-  const double r2 = x * x + y * y;
-  const double radial = 1.0 + r2 * (d[0] + r2 * (d[1] + r2 * d[4]));
-  const double xd = x * radial + 2.0 * d[2] * x * y + d[3] * (r2 + 2.0 * x * x);
-  const double yd = y * radial + d[2] * (r2 + 2.0 * y * y) + 2.0 * d[3] * x * y;
-  r = Vec2(cam.fx * xd + cam.cx - obs.x(), cam.fy * yd + cam.cy - obs.y());
-  if (J == nullptr) return true;
-  const double dradial = d[0] + r2 * (2.0 * d[1] + 3.0 * r2 * d[4]);
-  // A = diag(fx, fy) * d(xd, yd)/d(x, y), scaled by 1/z (the pinhole's Jacobian).
-  const double a00 =
-      cam.fx * iz * (radial + 2.0 * x * x * dradial + 2.0 * d[2] * y + 6.0 * d[3] * x);
-  const double a01 = cam.fx * iz * (2.0 * x * y * dradial + 2.0 * d[2] * x + 2.0 * d[3] * y);
-  const double a10 = cam.fy * iz * (2.0 * x * y * dradial + 2.0 * d[2] * x + 2.0 * d[3] * y);
-  const double a11 =
-      cam.fy * iz * (radial + 2.0 * y * y * dradial + 6.0 * d[2] * y + 2.0 * d[3] * x);
-  // d(px)/d(Xc) = [a00 a01 -(a00 x + a01 y); a10 a11 -(a10 x + a11 y)], then times R.
-  const double b02 = -(a00 * x + a01 * y), b12 = -(a10 * x + a11 * y);
-  for (int c = 0; c < 3; ++c) {
-    J[c] = a00 * R(0, c) + a01 * R(1, c) + b02 * R(2, c);
-    J[3 + c] = a10 * R(0, c) + a11 * R(1, c) + b12 * R(2, c);
-  }
-  return true;
-}
-
-}  // namespace
-
 bool refine_gauss_newton(const CameraModel* const* cams, const Vec2* px, int n, Vec3& X_world,
                          double& rms_px, int max_iterations, double step_tolerance_mm) noexcept {
   if (n < 1 || n > kMaxCameras) return false;
@@ -86,9 +47,10 @@ bool refine_gauss_newton(const CameraModel* const* cams, const Vec2* px, int n, 
     double h00 = 0, h01 = 0, h02 = 0, h11 = 0, h12 = 0, h22 = 0, g0 = 0, g1 = 0, g2 = 0;
     double sq = 0.0;
     for (int k = 0; k < n; ++k) {
-      Vec2 r;
+      Vec2 p;
       double J[6];
-      if (!residual(*cams[k], X, px[k], r, last ? nullptr : J)) return false;
+      if (!project_jacobian(*cams[k], X, p, last ? nullptr : J)) return false;
+      const Vec2 r = p - px[k];
       sq += r.squaredNorm();
       if (last) continue;
       const double* u = J;
