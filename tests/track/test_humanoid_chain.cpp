@@ -135,6 +135,45 @@ TEST(HumanoidChain, HandUnderChainSolvedForearm) {
             0.5);
 }
 
+// A partial point that is only a sliver of a ball (sigma 8 mm: its gate wider than the
+// hand's marker spacing) identifies no marker: it must not tie with the whole point of
+// a marker and leave that marker unlabelled as ambiguous (6 cameras smooth, frame 16:
+// the hand then rested on two biased partial points, wrist_l 1.95 deg off).
+TEST(HumanoidChain, AnUncertainPartialPointDoesNotHideAWholeOne) {
+  Humanoid h = Humanoid::make();
+  const std::size_t nb = h.scene.targets.bodies.size();
+  const auto hand = static_cast<std::size_t>(h.body("hand_l"));
+  std::vector<MeasuredPoint> pts;
+  BodyPoses poses;
+  ChainResult r;
+  const sim::SceneState st = h.state(1.0);
+  std::vector<bool> found(nb, true);
+  found[hand] = false;
+  h.frame(st, std::vector<int>(nb, -1), found, pts, poses);
+  // The hand's marker 2 (points in body order); the sliver lies 6 mm from it, on its locus.
+  int whole2 = 2;
+  for (std::size_t b = 0; b < hand; ++b)
+    whole2 += static_cast<int>(h.scene.targets.bodies[b].markers_body.size());
+  const auto& markers = h.scene.targets.bodies[hand].markers_body;
+  const Vec3 centre = st.T_world_body[hand] * h.solver.model().joint(h.joint("wrist_l")).c_child;
+  const Vec3 x2 = pts[static_cast<std::size_t>(whole2)].X_world;
+  const Vec3 tangent = (x2 - centre).unitOrthogonal();
+  MeasuredPoint sliver;
+  sliver.X_world = centre + (x2 + 6.0 * tangent - centre).normalized() * (x2 - centre).norm();
+  sliver.blob_index = {static_cast<std::int16_t>(pts.size()),
+                       static_cast<std::int16_t>(pts.size())};
+  sliver.partial = true;
+  pts.push_back(sliver);
+  ASSERT_EQ(markers.size(), 4u);
+  std::vector<double> partial_sigma(pts.size(), 0.0);
+  partial_sigma.back() = 8.0;
+  h.solver.solve(pts.data(), static_cast<int>(pts.size()), kHumanoidDt, poses, r,
+                 partial_sigma.data());
+  ASSERT_TRUE(r.chain_body[hand]);
+  EXPECT_EQ(r.point_index_of_marker[hand][2], whole2);
+  EXPECT_EQ(r.markers[hand], 4);
+}
+
 TEST(HumanoidChain, PosesThatDisagreeWithTheJointAreNotValid) {
   Humanoid h = Humanoid::make();
   const std::size_t nb = h.scene.targets.bodies.size();
