@@ -1,7 +1,11 @@
 // Design: the labelling half of chain tracking (chain_solver.h, step 2 and 3): which of
 // the frame's available points are which markers of a child body, given the parent's
-// pose and the calibrated joint, and the initial joint rotation from those labels.
+// pose and the calibrated joint, and the initial joint rotation from those labels. A point
+// is a candidate only when its gate is less than half the closest two markers' distance
+// (otherwise it could be any of them, and would tie with a whole point of one).
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "track/chain_solver.h"
 
@@ -74,6 +78,13 @@ int ChainSolver::label_child(int j, const Iso3& T_world_parent, const MeasuredPo
   s.k = static_cast<int>(markers.size());
   for (int p = 0; p < n; ++p)
     s.tol_mm[static_cast<std::size_t>(p)] = config_.gate_sigmas * std::sqrt(sigma_sq(p, pts[p]));
+  // A point identifies a marker only when its gate leaves out every other marker of the
+  // body: gate < half the closest two markers' distance. A partial point less certain than
+  // that (a sliver of a ball) could be any of them, and would tie with a whole point.
+  double min_sep = std::numeric_limits<double>::infinity();
+  for (std::size_t a = 0; a < markers.size(); ++a)
+    for (std::size_t b = a + 1; b < markers.size(); ++b)
+      min_sep = std::min(min_sep, (markers[a] - markers[b]).norm());
   for (int m = 0; m < s.k; ++m) {
     const auto um = static_cast<std::size_t>(m);
     s.cand_count[um] = 0;
@@ -88,6 +99,7 @@ int ChainSolver::label_child(int j, const Iso3& T_world_parent, const MeasuredPo
     for (int p = 0; p < n && !overflow; ++p) {
       if (!available_[static_cast<std::size_t>(p)]) continue;
       const double tol = s.tol_mm[static_cast<std::size_t>(p)];
+      if (!(2.0 * tol < min_sep)) continue;
       const Vec3 d = pts[p].X_world - c_w;
       if (cj.type == JointType::kHinge) {
         const double dh = a_w.dot(d);

@@ -1,21 +1,28 @@
 // Design: see chain_solver.h. Joints whose child was found by identification, its parent
-// found too or solved through the chain: the calibrated joint is a measurement too. The parent's
-// pose predicts where the joint centre is (T_world_parent * c_parent, with the covariance of the
-// parent's fit carried to the centre, plus the model's centre error); the child's pose
-// must put its own c_child there. Per joint, from the roots down:
-//  - ball: the child's pose is refitted on its labelled markers (weights 1/sigma^2) plus
-//    the predicted centre as one more point with its full covariance (6-dof Gauss-Newton
-//    from the identified pose), dropping the child's worst marker while the test fails
-//    and 3 remain. A hand's 3-4 markers span a few cm; the wrist centre
-//    8 cm away fixes the rotation that their spread leaves loose.
-//  - hinge: the centre agreement alone is tested (the axis already fixes 2 of the 3
-//    rotations, and its two bodies are long: the refit would change little).
-// Either way the chi-square test (3 (m + 1) - 6 degrees of freedom for the refit, 3 for
-// the hinge's centre) at `confidence` decides: a joint whose two poses disagree with the
-// joint beyond the noise is not valid (pose_rejects) — one of the poses is wrong, and
-// an angle from it would be too. Standard deviations: the refit's rotation covariance
-// plus the parent's, in the parent's frame.
+// found too or solved through the chain: the calibrated joint is a measurement too. The
+// parent's pose predicts where the joint centre is (T_world_parent * c_parent, with the
+// covariance of the parent's fit carried to the centre, plus the model's centre error)
+// and, for a hinge, the axis direction (the parent's rotation noise carried to it, plus
+// the model's axis error). The child's pose is refitted (6-dof Gauss-Newton from the
+// identified pose) on its labelled markers, each weighted by its measurement noise alone
+// (point or partial sigma: the chain's model error is the centre's and axis's), plus the
+// centre as one more point with its full covariance and, for a hinge, the two components
+// of the child's axis across the parent's (which must be 0).
+// Tests at `confidence`: the weighted sum of squares (3 (m + 1) + 2 [hinge] - 6 degrees of
+// freedom) and every term alone: the drop of the sum when it leaves the fit,
+// r^T (Sigma - J H^-1 J^T)^-1 r, against chi-square with its own dof. A marker biased
+// along the rotation its body's spread leaves loose (a forearm's 5 markers nearly in a
+// line: its roll) is mostly absorbed by the body's own fit, which therefore passes
+// identification's tests; the joint's evidence holds that rotation and exposes it. The
+// worst term is dropped while a test fails and 2 markers remain (2 labels plus the joint
+// determine the pose, as for a warm chain joint); when the centre or the axis is the worst,
+// the two poses disagree: the joint is not valid (pose_rejects) — one of the poses is
+// wrong, and an angle from it would be too. So is a refit whose rotation sd exceeds
+// max_sd_deg. Standard deviations: the refit's rotation covariance plus the parent's, in
+// the parent's frame.
+#include <Eigen/Eigenvalues>
 #include <cmath>
+#include <numbers>
 
 #include "core/rotation.h"
 #include "identify/consistency.h"
@@ -55,69 +62,129 @@ Mat3 ChainSolver::centre_cov(int b, const Vec3& c_world, const BodyPoses& poses,
   return (s2 / m + c2) * Mat3::Identity() + L * body_cov(b, poses, out) * L.transpose();
 }
 
-bool ChainSolver::refit_child(int j, const Vec3& c_w, const Mat3& W_c, const MeasuredPoint* pts,
-                              int n, const BodyPose& child,
-                              std::array<std::int16_t, kMaxMarkers>& labels, Iso3& T_wc,
-                              Mat3& cov_R) const noexcept {
+bool ChainSolver::refit_child(int j, const JointEvidence& ev, const MeasuredPoint* pts, int n,
+                              const BodyPose& child, std::array<std::int16_t, kMaxMarkers>& labels,
+                              Iso3& T_wc, Mat3& cov_R) const noexcept {
+  using Mat6 = Eigen::Matrix<double, 6, 6>;
+  using Vec6 = Eigen::Matrix<double, 6, 1>;
+  using Jac3 = Eigen::Matrix<double, 3, 6>;
   const ChainJoint& cj = model_.joint(j);
   const std::vector<Vec3>& markers = model_.markers(cj.child);
   labels = child.point_index_of_marker;
   for (std::size_t k = 0; k < markers.size(); ++k)
     if (labels[k] >= n) labels[k] = -1;
-  // Drop the worst marker while the test fails and 3 remain (the centre is never
-  // dropped: when it is the worst, the two poses disagree).
+  const double q3 = chi2_quantile(3, config_.confidence);
+  const double q2 = chi2_quantile(2, config_.confidence);
+  // Residuals and Jacobians (rotation increment left-multiplied, world frame) at (R, t).
+  const auto marker_term = [&](const Mat3& R, const Vec3& t, std::size_t k, Vec3& r, Jac3& J) {
+    const Vec3 Rx = R * markers[k];
+    r = Rx + t - pts[labels[k]].X_world;
+    J.leftCols<3>() = -skew3(Rx);
+    J.rightCols<3>() = Mat3::Identity();
+  };
+  const auto centre_term = [&](const Mat3& R, const Vec3& t, Vec3& r, Jac3& J) {
+    const Vec3 Rx = R * cj.c_child;
+    r = Rx + t - ev.c_w;
+    J.leftCols<3>() = -skew3(Rx);
+    J.rightCols<3>() = Mat3::Identity();
+  };
+  // Hinge: the child's axis must lie along the parent's (its components across it are 0).
+  const auto axis_term = [&](const Mat3& R, Eigen::Vector2d& r, Eigen::Matrix<double, 2, 6>& J) {
+    const Vec3 b = R * cj.axis_child;
+    r = ev.U.transpose() * b;
+    J.leftCols<3>() = -ev.U.transpose() * skew3(b);
+    J.rightCols<3>().setZero();
+  };
+  // Normal equations and weighted sum of squares of every term at (R, t).
+  const auto normal = [&](const Mat3& R, const Vec3& t, Mat6& H, Vec6& g, int& m) {
+    H.setZero();
+    g.setZero();
+    double chi2 = 0.0;
+    m = 0;
+    Vec3 r;
+    Jac3 J;
+    for (std::size_t k = 0; k < markers.size(); ++k) {
+      if (labels[k] < 0) continue;
+      marker_term(R, t, k, r, J);
+      const double w = 1.0 / point_sigma_sq(labels[k], pts[labels[k]]);
+      H += w * J.transpose() * J;
+      g += w * J.transpose() * r;
+      chi2 += w * r.squaredNorm();
+      ++m;
+    }
+    centre_term(R, t, r, J);
+    H += J.transpose() * ev.W_c * J;
+    g += J.transpose() * ev.W_c * r;
+    chi2 += r.dot(ev.W_c * r);
+    if (ev.hinge) {
+      Eigen::Vector2d ra;
+      Eigen::Matrix<double, 2, 6> Ja;
+      axis_term(R, ra, Ja);
+      H += Ja.transpose() * ev.W_a * Ja;
+      g += Ja.transpose() * ev.W_a * ra;
+      chi2 += ra.dot(ev.W_a * ra);
+    }
+    return chi2;
+  };
   for (int round = 0; round < kMaxMarkers; ++round) {
     Mat3 R = child.T_world_body.linear();
     Vec3 t = child.T_world_body.translation();
-    Eigen::Matrix<double, 6, 6> H;
-    double chi2 = 0.0, worst = -1.0, centre_e = 0.0;
-    int m = 0, worst_k = -1;
-    for (int iter = 0; iter < 5; ++iter) {
-      H.setZero();
-      Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
-      chi2 = 0.0;
-      worst = -1.0;
-      m = 0;
-      const auto add = [&](const Vec3& x_body, const Vec3& meas, const Mat3& W) {
-        const Vec3 Rx = R * x_body;
-        const Vec3 r = Rx + t - meas;
-        Eigen::Matrix<double, 3, 6> J;
-        J.leftCols<3>() = -skew3(Rx);
-        J.rightCols<3>() = Mat3::Identity();
-        H += J.transpose() * W * J;
-        g += J.transpose() * W * r;
-        const double e = r.dot(W * r);
-        chi2 += e;
-        return e;
-      };
-      for (std::size_t k = 0; k < markers.size(); ++k) {
-        const int p = labels[k];
-        if (p < 0) continue;
-        const double e = add(markers[k], pts[p].X_world, Mat3::Identity() / sigma_sq(p, pts[p]));
-        if (e > worst) worst = e, worst_k = static_cast<int>(k);
-        ++m;
-      }
-      centre_e = add(cj.c_child, c_w, W_c);
-      if (m < 3) return false;
-      const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> ldlt(H);
+    Mat6 H;
+    Vec6 g;
+    int m = 0;
+    double chi2 = 0.0;
+    for (int iter = 0; iter < 6; ++iter) {
+      chi2 = normal(R, t, H, g, m);
+      if (m < 2) return false;
+      const Eigen::LDLT<Mat6> ldlt(H);
       if (ldlt.info() != Eigen::Success) return false;
-      const Eigen::Matrix<double, 6, 1> step = ldlt.solve(-g);
+      const Vec6 step = ldlt.solve(-g);
       if (!step.allFinite()) return false;
+      if (step.cwiseAbs().maxCoeff() < 1e-10) break;
       const double a = step.head<3>().norm();
       const Mat3 dR =
           a > 1e-15 ? Mat3(Eigen::AngleAxisd(a, step.head<3>() / a)) : Mat3(Mat3::Identity());
       R = dR * R;
       t = dR * t + step.tail<3>();
-      if (step.cwiseAbs().maxCoeff() < 1e-10) break;
     }
-    if (chi2 <= chi2_quantile(3 * (m + 1) - 6, config_.confidence)) {
+    chi2 = normal(R, t, H, g, m);
+    const Mat6 C = H.ldlt().solve(Mat6::Identity());
+    // Each term tested alone: the drop of the sum of squares when it leaves the fit,
+    // r^T (Sigma - J C J^T)^-1 r (a biased marker is diluted in the global sum, and the
+    // fit absorbs most of it along the directions its spread leaves loose). As a share of
+    // its own chi-square quantile; the largest names the worst term.
+    double worst = 0.0, joint_worst = 0.0;
+    int worst_k = -1;
+    Vec3 r;
+    Jac3 J;
+    for (std::size_t k = 0; k < markers.size(); ++k) {
+      if (labels[k] < 0) continue;
+      marker_term(R, t, k, r, J);
+      const Mat3 S =
+          point_sigma_sq(labels[k], pts[labels[k]]) * Mat3::Identity() - J * C * J.transpose();
+      const double d = r.dot(S.ldlt().solve(r)) / q3;
+      if (std::isfinite(d) && d > worst) worst = d, worst_k = static_cast<int>(k);
+    }
+    centre_term(R, t, r, J);
+    const double dc = r.dot((ev.cov_c - J * C * J.transpose()).ldlt().solve(r)) / q3;
+    if (std::isfinite(dc)) joint_worst = dc;
+    if (ev.hinge) {
+      Eigen::Vector2d ra;
+      Eigen::Matrix<double, 2, 6> Ja;
+      axis_term(R, ra, Ja);
+      const double da = ra.dot((ev.cov_a - Ja * C * Ja.transpose()).ldlt().solve(ra)) / q2;
+      if (std::isfinite(da)) joint_worst = std::max(joint_worst, da);
+    }
+    const int dof = 3 * (m + 1) + (ev.hinge ? 2 : 0) - 6;
+    if (chi2 <= chi2_quantile(dof, config_.confidence) && worst <= 1.0 && joint_worst <= 1.0) {
       T_wc = Iso3::Identity();
       T_wc.linear() = R;
       T_wc.translation() = t;
-      cov_R = H.ldlt().solve(Eigen::Matrix<double, 6, 6>::Identity()).topLeftCorner<3, 3>();
+      cov_R = C.topLeftCorner<3, 3>();
       return true;
     }
-    if (m <= 3 || centre_e >= worst || worst_k < 0) return false;
+    // The joint's own evidence the worst: the two poses disagree (no drop).
+    if (m <= 2 || joint_worst >= worst || worst_k < 0) return false;
     labels[static_cast<std::size_t>(worst_k)] = -1;
   }
   return false;
@@ -143,33 +210,39 @@ void ChainSolver::check_pose_joints(const MeasuredPoint* pts, int n, const BodyP
     const Iso3& T_wp = out.chain_body[up] || out.refined_body[up] ? out.T_world_body[up]
                                                                   : poses.bodies[up].T_world_body;
     const Vec3 c_w = T_wp * cj.c_parent;
-    const Mat3 cov_c = centre_cov(cj.parent, c_w, poses, out);
     const Mat3 R_wp = T_wp.linear();
-    if (cj.dof == 1) {
-      // Hinge: the two poses' centres must agree.
-      const Vec3 d = c_w - child.T_world_body * cj.c_child;
-      const Mat3 cov = cov_c + centre_cov(cj.child, child.T_world_body * cj.c_child, poses, out);
-      const Eigen::LDLT<Mat3> ldlt(cov);
-      if (ldlt.info() != Eigen::Success ||
-          !(d.dot(ldlt.solve(d)) <= chi2_quantile(3, config_.confidence))) {
-        reject(uj);
-      } else if (out.refined_body[up]) {
-        // The parent was refitted: its (smaller) rotation covariance.
-        const Mat3 cov_rel = R_wp.transpose() *
-                             (body_cov(cj.parent, poses, out) + body_cov(cj.child, poses, out)) *
-                             R_wp;
-        out.joints[uj].sd_rad = {
-            std::sqrt(std::max(0.0, cj.axis_parent.dot(cov_rel * cj.axis_parent))), 0.0, 0.0};
-      }
-      continue;
-    }
-    // Ball: refit the child with the centre as one more measured point.
-    const Eigen::LDLT<Mat3> cl(cov_c);
+    JointEvidence ev;
+    ev.c_w = c_w;
+    ev.cov_c = centre_cov(cj.parent, c_w, poses, out);
+    const Eigen::LDLT<Mat3> cl(ev.cov_c);
     if (cl.info() != Eigen::Success) continue;
+    ev.W_c = cl.solve(Mat3::Identity());
+    ev.hinge = cj.dof == 1;
+    if (ev.hinge) {
+      // The parent's axis, its direction noise from the parent's rotation noise plus the
+      // calibrated axis's own error, across the axis (two directions U).
+      const Vec3 a_w = R_wp * cj.axis_parent;
+      const Vec3 u1 = a_w.unitOrthogonal();
+      ev.U.col(0) = u1;
+      ev.U.col(1) = a_w.cross(u1);
+      const Mat3 A = skew3(a_w);
+      const double sa = config_.axis_sigma_deg * std::numbers::pi / 180.0;
+      ev.cov_a = ev.U.transpose() * A * body_cov(cj.parent, poses, out) * A.transpose() * ev.U +
+                 sa * sa * Eigen::Matrix2d::Identity();
+      const Eigen::LDLT<Eigen::Matrix2d> al(ev.cov_a);
+      if (al.info() != Eigen::Success) continue;
+      ev.W_a = al.solve(Eigen::Matrix2d::Identity());
+    }
     std::array<std::int16_t, kMaxMarkers> labels{};
     Iso3 T_wc;
     Mat3 cov_R;
-    if (!refit_child(j, c_w, cl.solve(Mat3::Identity()), pts, n, child, labels, T_wc, cov_R)) {
+    // Like a chain angle, the refitted pose must be certain enough (with 2 markers left
+    // it may not be: markers nearly in line with the centre).
+    if (!refit_child(j, ev, pts, n, child, labels, T_wc, cov_R) ||
+        !(std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Mat3>(cov_R, Eigen::EigenvaluesOnly)
+                                      .eigenvalues()
+                                      .maxCoeff())) <=
+          config_.max_sd_deg * std::numbers::pi / 180.0)) {
       reject(uj);
       continue;
     }
@@ -195,7 +268,11 @@ void ChainSolver::check_pose_joints(const MeasuredPoint* pts, int n, const BodyP
     out.rms_mm[uc] = m > 0 ? std::sqrt(ss / m) : 0.0;
     refined_cov_[uc] = cov_R;
     const Mat3 cov = R_wp.transpose() * (cov_R + body_cov(cj.parent, poses, out)) * R_wp;
-    out.joints[uj].sd_rad = chain_detail::euler_sd(R_wp.transpose() * T_wc.linear(), cov);
+    if (ev.hinge)
+      out.joints[uj].sd_rad = {std::sqrt(std::max(0.0, cj.axis_parent.dot(cov * cj.axis_parent))),
+                               0.0, 0.0};
+    else
+      out.joints[uj].sd_rad = chain_detail::euler_sd(R_wp.transpose() * T_wc.linear(), cov);
     ++counters_.pose_refits;
   }
 }

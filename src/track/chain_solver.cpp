@@ -43,6 +43,7 @@ Expected<ChainSolver> ChainSolver::create(ChainModel model, const ChainConfig& c
     return bad("max_angular_speed_deg_per_s", "must be > 0");
   if (!(config.max_prior_age_s > 0.0)) return bad("max_prior_age_s", "must be > 0");
   if (!(config.max_sd_deg > 0.0)) return bad("max_sd_deg", "must be > 0");
+  if (!(config.axis_sigma_deg > 0.0)) return bad("axis_sigma_deg", "must be > 0");
   if (config.max_search_nodes < 16) return bad("max_search_nodes", "must be >= 16");
   if (model.joint_count() > kMaxBodies)
     return make_error("model.yaml", "joints",
@@ -61,12 +62,16 @@ void ChainSolver::reset() noexcept {
   for (Prior& p : priors_) p.valid = false;
 }
 
-double ChainSolver::sigma_sq(int p, const MeasuredPoint& pt) const noexcept {
+double ChainSolver::point_sigma_sq(int p, const MeasuredPoint& pt) const noexcept {
   double partial = config_.partial_sigma_mm;
   if (partial_sigma_mm_ != nullptr && p >= 0 && p < partial_sigma_count_)
     partial = partial_sigma_mm_[p];
   const double s = pt.partial ? std::max(partial, config_.point_sigma_mm) : config_.point_sigma_mm;
-  return s * s + config_.model_sigma_mm * config_.model_sigma_mm;
+  return s * s;
+}
+
+double ChainSolver::sigma_sq(int p, const MeasuredPoint& pt) const noexcept {
+  return point_sigma_sq(p, pt) + config_.model_sigma_mm * config_.model_sigma_mm;
 }
 
 void ChainSolver::forward(const BodyPoses& poses, ChainResult& out) const noexcept {

@@ -28,9 +28,10 @@
 //     left without enough markers is dropped with its descendants. Angles whose standard
 //     deviation exceeds max_sd_deg are not published either. Never a wrong angle.
 //  6. joints whose child was found by identification, the parent found or chain-solved
-//     (chain_poses.cpp): the parent's pose predicts the joint
-//     centre; a ball's child is refitted on its markers plus that centre, a hinge's two
-//     centres must agree; a chi-square failure makes the angle invalid (inconsistent).
+//     (chain_poses.cpp): the parent's pose predicts the joint centre (and a hinge's axis);
+//     the child is refitted on its markers plus that evidence, each marker also tested
+//     alone; a marker the joint exposes is dropped, a disagreement of the two poses makes
+//     the angle invalid (inconsistent).
 // A partial point's noise is derived from its image (the visible fraction of its most
 // hidden view, marker_shape.h partial_centroid_shift), passed in by FrameProcessor.
 // Every joint reports how it was solved (client::SolvedBy) and the standard deviation of
@@ -131,6 +132,9 @@ struct ChainConfig {
   // Per-coordinate error of a calibrated joint centre (docs/evaluation.md measures
   // 0.02-0.09 mm): part of the centre test of joints whose child was found.
   double centre_sigma_mm = 0.1;
+  // Per-component error (deg) of a calibrated hinge axis's direction, parent against child
+  // (docs/evaluation.md measures 0.003-0.044 deg): part of the refit of a hinge's found child.
+  double axis_sigma_deg = 0.05;
   int max_search_nodes = 4000;  // labelling search budget per joint and frame
 };
 
@@ -215,13 +219,29 @@ class ChainSolver {
   // Per-coordinate variance of point p (index in this frame's points): its noise plus the
   // model's marker error.
   double sigma_sq(int p, const MeasuredPoint& pt) const noexcept;
+  // The same without the model's error: point p measured as a marker of a body whose own
+  // pose is fitted (the refit of a found child, chain_poses.cpp).
+  double point_sigma_sq(int p, const MeasuredPoint& pt) const noexcept;
   // Joints whose child was found (chain_poses.cpp): ball refit with the joint centre, centre
   // test, standard deviations.
   void check_pose_joints(const MeasuredPoint* pts, int n, const BodyPoses& poses,
                          ChainResult& out) noexcept;
-  // The ball joint j's found child refitted on its labels plus the centre c_w (weight
-  // W_c), dropping its worst marker while the chi-square fails; false: inconsistent.
-  bool refit_child(int j, const Vec3& c_w, const Mat3& W_c, const MeasuredPoint* pts, int n,
+  // What the parent's pose says about a found child's pose (chain_poses.cpp): the joint
+  // centre c_w (covariance cov_c, weight W_c = cov_c^-1) and, for a hinge, the axis:
+  // the child's axis has no component along U (the two directions across the parent's
+  // axis; covariance cov_a, weight W_a).
+  struct JointEvidence {
+    Vec3 c_w = Vec3::Zero();
+    Mat3 cov_c = Mat3::Identity();
+    Mat3 W_c = Mat3::Identity();
+    bool hinge = false;
+    Eigen::Matrix<double, 3, 2> U = Eigen::Matrix<double, 3, 2>::Zero();
+    Eigen::Matrix2d cov_a = Eigen::Matrix2d::Identity();
+    Eigen::Matrix2d W_a = Eigen::Matrix2d::Identity();
+  };
+  // Joint j's found child refitted on its labels plus the joint's evidence, dropping its
+  // worst marker while the chi-square tests fail; false: inconsistent.
+  bool refit_child(int j, const JointEvidence& ev, const MeasuredPoint* pts, int n,
                    const BodyPose& child, std::array<std::int16_t, kMaxMarkers>& labels, Iso3& T_wc,
                    Mat3& cov_R) const noexcept;
   // Covariance (mm^2, world) of the joint centre c_world as placed by body b's pose.
