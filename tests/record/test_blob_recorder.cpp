@@ -57,14 +57,21 @@ Image blob_test_image(int c, std::int64_t f) {
   return im;
 }
 
-TEST(BlobRecorder, WritesEveryBlobListAndTheKeptImagesFromTheDetectThreads) {
-  test::TempDir dir("rec_blobs");
-  write_blob_rig(dir.path());
+// Blob-mode options of a two-camera recorder into `dir` (the tests set the rest).
+RecorderOptions two_camera_options(const std::string& dir) {
   RecorderOptions o;
-  o.dir = dir.path();
+  o.dir = dir;
   o.camera_names = {"cam0", "cam1"};
   o.cameras = {CameraGeometry{kBlobW, kBlobH, PixelFormat::kMono8},
                CameraGeometry{kBlobW, kBlobH, PixelFormat::kMono8}};
+  o.blobs = true;
+  return o;
+}
+
+TEST(BlobRecorder, WritesEveryBlobListAndTheKeptImagesFromTheDetectThreads) {
+  test::TempDir dir("rec_blobs");
+  write_blob_rig(dir.path());
+  RecorderOptions o = two_camera_options(dir.path());
   o.slots_per_camera = 4;
   o.wait_for_slot_ms = 5000;  // lossless (lockstep): the tap waits for the writer
   o.blobs = true;
@@ -166,11 +173,7 @@ TEST(BlobRecorder, WritesEveryBlobListAndTheKeptImagesFromTheDetectThreads) {
 TEST(BlobRecorder, ASilentCameraDoesNotStallTheRecording) {
   test::TempDir dir("rec_blobs_silent");
   write_blob_rig(dir.path());
-  RecorderOptions o;
-  o.dir = dir.path();
-  o.camera_names = {"cam0", "cam1"};
-  o.cameras = {CameraGeometry{kBlobW, kBlobH, PixelFormat::kMono8},
-               CameraGeometry{kBlobW, kBlobH, PixelFormat::kMono8}};
+  RecorderOptions o = two_camera_options(dir.path());
   o.slots_per_camera = 16;
   o.blobs = true;
   o.max_blobs = 8;
@@ -216,11 +219,7 @@ TEST(BlobRecorder, ASilentCameraDoesNotStallTheRecording) {
 
 TEST(BlobRecorder, NoCameraFoldersWithoutKeptImages) {
   test::TempDir dir("rec_blobs_nokeep");
-  RecorderOptions o;
-  o.dir = dir.path();
-  o.camera_names = {"cam0", "cam1"};
-  o.cameras = {CameraGeometry{kBlobW, kBlobH, PixelFormat::kMono8},
-               CameraGeometry{kBlobW, kBlobH, PixelFormat::kMono8}};
+  RecorderOptions o = two_camera_options(dir.path());
   o.blobs = true;
   o.max_blobs = 0;
   EXPECT_FALSE(FrameRecorder::create(o));  // a capacity of 0 blobs is refused
