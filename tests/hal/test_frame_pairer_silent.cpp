@@ -15,12 +15,12 @@ namespace mocap::hal {
 namespace {
 
 // Three cameras; camera 2 (a node's) is silent after 100 ns of waiting.
-struct Rig {
+struct SilentPairerRig {
   FramePairer pairer;
   std::vector<FramePair> sets;
   std::vector<std::pair<int, std::int64_t>> dropped;
 
-  explicit Rig(std::int64_t bound = 100, std::uint32_t max_pending = 8)
+  explicit SilentPairerRig(std::int64_t bound = 100, std::uint32_t max_pending = 8)
       : pairer(*FramePairer::create(config(bound, max_pending))) {}
   static PairerConfig config(std::int64_t bound, std::uint32_t max_pending) {
     PairerConfig c{0, max_pending, 3, {}};
@@ -49,7 +49,7 @@ struct Rig {
 };
 
 TEST(FramePairerSilent, ASilentCameraIsLeftOutAfterItsBoundAndUsedAgainWhenBack) {
-  Rig r;
+  SilentPairerRig r;
   for (int c : {0, 1, 2}) r.push(c, 0, 1);  // a full set
   ASSERT_EQ(r.sets.size(), 1u);
   EXPECT_TRUE(r.has2(0));
@@ -84,7 +84,7 @@ TEST(FramePairerSilent, ASilentCameraIsLeftOutAfterItsBoundAndUsedAgainWhenBack)
 }
 
 TEST(FramePairerSilent, KeysThatStartOverKeepTheCameraSilent) {
-  Rig r;
+  SilentPairerRig r;
   for (std::int64_t s = 0; s < 50; ++s)
     for (int c : {0, 1, 2}) r.push(c, s, 1 + s);
   r.push(0, 50, 100);
@@ -104,7 +104,7 @@ TEST(FramePairerSilent, KeysThatStartOverKeepTheCameraSilent) {
 // A wait longer than the queues hold: the others' oldest frames overflow, the wait
 // still counts from the first frame that waited, and what is pending then completes.
 TEST(FramePairerSilent, TheWaitOutlastsTheOthersQueueOverflow) {
-  Rig r(100, 2);
+  SilentPairerRig r(100, 2);
   for (std::int64_t s = 0; s < 6; ++s) {
     r.push(0, s, 10 + 20 * s);
     r.push(1, s, 10 + 20 * s);
@@ -119,16 +119,16 @@ TEST(FramePairerSilent, TheWaitOutlastsTheOthersQueueOverflow) {
 }
 
 TEST(FramePairerSilent, NothingIsInventedWithoutABoundOrWithoutAWaitingFrame) {
-  Rig unbounded(0);
+  SilentPairerRig unbounded(0);
   unbounded.push(0, 1, 10);
   unbounded.push(1, 1, 10);
   EXPECT_EQ(unbounded.expire(1'000'000'000), 0);
   EXPECT_FALSE(unbounded.pairer.silent(2));
-  Rig quiet;  // every camera silent: nobody waits, no set
+  SilentPairerRig quiet;  // every camera silent: nobody waits, no set
   EXPECT_EQ(quiet.expire(1'000'000'000), 0);
   EXPECT_FALSE(quiet.pairer.silent(2));
   // A camera the bounded one waits for is not declared silent (no bound of its own).
-  Rig other;
+  SilentPairerRig other;
   other.push(2, 1, 10);
   other.push(0, 1, 10);
   EXPECT_EQ(other.expire(1'000'000'000), 0);
@@ -163,7 +163,7 @@ TEST(FramePairerSilent, TimestampsPairAgainAfterTheNodeCameBack) {
 }
 
 TEST(FramePairerSilent, ExpireAllocatesNothing) {
-  Rig r;
+  SilentPairerRig r;
   r.sets.reserve(4000);
   r.dropped.reserve(4000);
   test::AllocationScope scope;
