@@ -121,17 +121,6 @@ class FoxgloveSink final : public QueuedSink {
 };
 
 // A positive integer option (max_clients, client_queue) or the default.
-Expected<int> int_option(const OutputRequest& r, const char* key, int fallback, int max) {
-  const std::string* v = r.option(key);
-  if (v == nullptr) return fallback;
-  if (v->empty() || v->size() > 6 || v->find_first_not_of("0123456789") != std::string::npos ||
-      std::stoi(*v) < 1 || std::stoi(*v) > max) {
-    return make_error(r.where, key,
-                      "expected an integer 1.." + std::to_string(max) + ", got '" + *v + "'");
-  }
-  return std::stoi(*v);
-}
-
 Expected<foxglove::ServerOptions> options_of(const OutputRequest& r) {
   if (r.values.size() != 1) {
     return make_error(
@@ -140,11 +129,12 @@ Expected<foxglove::ServerOptions> options_of(const OutputRequest& r) {
   }
   foxglove::ServerOptions o;
   if (auto a = foxglove::parse_listen_address(r.values[0], r.where, o); !a) return a.error();
-  auto clients = int_option(r, "max_clients", o.max_clients, 64);
+  auto clients = r.int_option("max_clients", o.max_clients, 1, 64);
   if (!clients) return clients.error();
-  auto queue = int_option(r, "client_queue", o.client_queue_depth, 4096);
+  auto queue = r.int_option("client_queue", o.client_queue_depth, 1, 4096);
   if (!queue) return queue.error();
-  if (auto rate = int_option(r, "max_rate_hz", kDefaultMaxRateHz, 1000); !rate) return rate.error();
+  if (auto rate = r.int_option("max_rate_hz", kDefaultMaxRateHz, 1, 1000); !rate)
+    return rate.error();
   o.max_clients = *clients;
   o.client_queue_depth = *queue;
   return o;
@@ -172,7 +162,7 @@ Expected<OutputCreated> create_foxglove(const OutputRequest& r, const OutputCont
       o->address.find(':') != std::string::npos ? "[" + o->address + "]" : o->address;
   const std::string url = "ws://" + host + ":" + std::to_string((*server)->port());
   (*server)->start();
-  auto rate = int_option(r, "max_rate_hz", kDefaultMaxRateHz, 1000);
+  auto rate = r.int_option("max_rate_hz", kDefaultMaxRateHz, 1, 1000);
   if (!rate) return rate.error();
   auto sink = std::make_unique<FoxgloveSink>(std::move(*scene), std::move(*server), url, *rate);
   if (auto s = sink->start(); !s) return s.error();

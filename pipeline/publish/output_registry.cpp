@@ -6,6 +6,18 @@
 
 namespace mocap::publish {
 
+Expected<int> OutputRequest::int_option(const char* key, int fallback, int lo, int hi) const {
+  const std::string* v = option(key);
+  if (v == nullptr) return fallback;
+  if (v->empty() || v->size() > 6 || v->find_first_not_of("0123456789") != std::string::npos ||
+      std::stoi(*v) < lo || std::stoi(*v) > hi) {
+    return make_error(where, key,
+                      "expected an integer " + std::to_string(lo) + ".." + std::to_string(hi) +
+                          ", got '" + *v + "'");
+  }
+  return std::stoi(*v);
+}
+
 // One declaration + one table line per output (each defined in its own file).
 extern const OutputKind kUdpOutput;      // udp_sink.cpp
 extern const OutputKind kIceoryxOutput;  // iceoryx_sink.cpp
@@ -19,9 +31,7 @@ extern const OutputKind kFoxgloveOutput;  // foxglove (branch foxglove)
 
 const std::vector<OutputKind>& output_kinds() {
   static const std::vector<OutputKind> kinds = {
-      kUdpOutput,
-      kIceoryxOutput,
-      kVrpnOutput,
+      kUdpOutput,      kIceoryxOutput, kVrpnOutput,
 #ifdef MOCAP_HAVE_ROS2
       kRos2Output,
 #endif

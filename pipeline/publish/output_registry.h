@@ -30,6 +30,9 @@ struct OutputRequest {
       if (k == key) return &v;
     return nullptr;
   }
+  // Option `key` as an integer in lo..hi (decimal digits only); `fallback` when it is not
+  // given; else "<where>: <key>: expected an integer lo..hi, got '<value>'".
+  Expected<int> int_option(const char* key, int fallback, int lo, int hi) const;
 };
 
 struct OutputCreated {

@@ -63,19 +63,6 @@ class VrpnSink final : public QueuedSink {
 };
 
 // An integer option in [lo, hi] or the default.
-Expected<int> vrpn_int_option(const OutputRequest& r, const char* key, int fallback, int lo,
-                              int hi) {
-  const std::string* v = r.option(key);
-  if (v == nullptr) return fallback;
-  if (v->empty() || v->size() > 6 || v->find_first_not_of("0123456789") != std::string::npos ||
-      std::stoi(*v) < lo || std::stoi(*v) > hi) {
-    return make_error(r.where, key,
-                      "expected an integer " + std::to_string(lo) + ".." + std::to_string(hi) +
-                          ", got '" + *v + "'");
-  }
-  return std::stoi(*v);
-}
-
 Expected<vrpn::ServerOptions> vrpn_options_of(const OutputRequest& r) {
   if (r.values.size() != 1)
     return make_error(
@@ -83,12 +70,12 @@ Expected<vrpn::ServerOptions> vrpn_options_of(const OutputRequest& r) {
         "expected one [ADDRESS:]PORT, got " + std::to_string(r.values.size()) + " values");
   vrpn::ServerOptions o;
   if (auto a = vrpn::parse_listen_address(r.values[0], r.where, o); !a) return a.error();
-  auto clients = vrpn_int_option(r, "max_clients", o.max_clients, 1, 64);
+  auto clients = r.int_option("max_clients", o.max_clients, 1, 64);
   if (!clients) return clients.error();
-  auto kib = vrpn_int_option(r, "client_buffer_kib", static_cast<int>(o.client_buffer_bytes / 1024),
-                             16, 16384);
+  auto kib =
+      r.int_option("client_buffer_kib", static_cast<int>(o.client_buffer_bytes / 1024), 16, 16384);
   if (!kib) return kib.error();
-  auto stall = vrpn_int_option(r, "stall_ms", o.stall_ms, 100, 60000);
+  auto stall = r.int_option("stall_ms", o.stall_ms, 100, 60000);
   if (!stall) return stall.error();
   o.max_clients = *clients;
   o.client_buffer_bytes = static_cast<std::size_t>(*kib) * 1024;
