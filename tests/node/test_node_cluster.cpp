@@ -79,16 +79,20 @@ class NodeCluster : public ::testing::Test {
            ", realtime: false, lock_memory: false}\noutputs: {udp: [127.0.0.1:" +
            std::to_string(port) + "], iceoryx: false}\n";
   }
-  // timeout_ms: how long the central waits for a node's frame before it is missing (the
-  // sanitizer builds' nodes take ~0.1-0.3 s per frame).
-  void write_cluster(int port, double rate_hz, int timeout_ms) {
+  // Two nodes of 4 replay cameras each and the central's 8 node cameras. node_pipeline:
+  // the nodes' pipeline keys; node_trigger: their cameras' trigger; central_trigger: the
+  // central cameras' (empty: none given). timeout_ms: how long the central waits for a
+  // node's frame before it is missing (the sanitizer builds' nodes take ~0.1-0.3 s per frame).
+  void write_nodes_and_central(const std::string& node_pipeline, const std::string& node_trigger,
+                               const std::string& central_trigger, int timeout_ms,
+                               const std::string& central_keys) {
     for (int n = 0; n < 2; ++n) {
       std::string y = "node: {name: n" + std::to_string(n) +
-                      ", domain_id: " + std::to_string(domain_) +
-                      "}\npipeline: {realtime: false}\ncameras:\n";
+                      ", domain_id: " + std::to_string(domain_) + "}\npipeline: {" + node_pipeline +
+                      "}\ncameras:\n";
       for (int c = 4 * n; c < 4 * n + 4; ++c)
         y += "  - {backend: replay, device: " + recording() + ", camera: cam" + std::to_string(c) +
-             ", trigger: central}\n";
+             ", trigger: " + node_trigger + "}\n";
       write("node" + std::to_string(n) + ".yaml", y);
     }
     std::string y = "node: {domain_id: " + std::to_string(domain_) +
@@ -96,8 +100,13 @@ class NodeCluster : public ::testing::Test {
                     "}\nrig: " + recording() + "/rig.yaml\ncameras:\n";
     for (int c = 0; c < 8; ++c)
       y += "  - {backend: node, device: n" + std::to_string(c / 4) + "/cam" + std::to_string(c) +
-           "}\n";
-    write("central.yaml", y + tracker_keys(port, rate_hz));
+           (central_trigger.empty() ? "" : ", trigger: " + central_trigger) + "}\n";
+    write("central.yaml", y + central_keys);
+  }
+  // The nodes follow the central's triggers (lockstep at rate_hz).
+  void write_cluster(int port, double rate_hz, int timeout_ms) {
+    write_nodes_and_central("realtime: false", "central", "", timeout_ms,
+                            tracker_keys(port, rate_hz));
   }
   // The reference: the recording replayed by one process (8 local replay cameras).
   Published single_process(const test::KeepAllUdpSocket& sock) {
@@ -115,32 +124,19 @@ class NodeCluster : public ::testing::Test {
   // on one trigger line count together) and the central does not trigger (`trigger:
   // external` on its node cameras), pairing by sequence.
   void write_external_cluster(int port, double rate_hz, int timeout_ms) {
-    for (int n = 0; n < 2; ++n) {
-      std::string y = "node: {name: n" + std::to_string(n) +
-                      ", domain_id: " + std::to_string(domain_) +
-                      "}\npipeline: {realtime: false, trigger_rate_hz: " + std::to_string(rate_hz) +
-                      "}\ncameras:\n";
-      for (int c = 4 * n; c < 4 * n + 4; ++c)
-        y += "  - {backend: replay, device: " + recording() + ", camera: cam" + std::to_string(c) +
-             ", trigger: software}\n";
-      write("node" + std::to_string(n) + ".yaml", y);
-    }
-    std::string y = "node: {domain_id: " + std::to_string(domain_) +
-                    ", wait_s: 20, timeout_ms: " + std::to_string(timeout_ms) +
-                    "}\nrig: " + recording() + "/rig.yaml\ncameras:\n";
-    for (int c = 0; c < 8; ++c)
-      y += "  - {backend: node, device: n" + std::to_string(c / 4) + "/cam" + std::to_string(c) +
-           ", trigger: external}\n";
-    write("central.yaml",
-          y + "targets: " + recording() + "/targets.yaml\nmodel: " + recording() +
-              "/gt/model_true.yaml\npipeline: {pair_by: sequence, trigger_rate_hz: " +
-              std::to_string(rate_hz) +
-              ", realtime: false, lock_memory: false}\noutputs: {udp: [127.0.0.1:" +
-              std::to_string(port) + "], iceoryx: false}\n");
+    write_nodes_and_central(
+        "realtime: false, trigger_rate_hz: " + std::to_string(rate_hz), "software", "external",
+        timeout_ms,
+        "targets: " + recording() + "/targets.yaml\nmodel: " + recording() +
+            "/gt/model_true.yaml\npipeline: {pair_by: sequence, trigger_rate_hz: " +
+            std::to_string(rate_hz) +
+            ", realtime: false, lock_memory: false}\noutputs: {udp: [127.0.0.1:" +
+            std::to_string(port) + "], iceoryx: false}\n");
   }
+
   // Both nodes in the background, the central in the foreground; `kill_after_s` > 0
   // SIGKILLs node n1 that long after the central started, `restart_after_s` > 0 starts it
-  // again that much later (its replay starts at its first frame again).
+  // again that much later (its replay joins at the frame the next central trigger names).
   test::RunResult run_cluster(double kill_after_s, double restart_after_s = 0.0,
                               const std::string& central = "run") {
     const std::string m = test::mocap_binary();
