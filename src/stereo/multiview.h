@@ -7,9 +7,9 @@
 //   3. hypotheses with three or more views are refined over all of them (Gauss-Newton
 //      on the real-pixel reprojection error, nview.h); a view whose residual exceeds
 //      gate_px is dropped and the point refined again (an outlier never drags a point);
-//   4. hypotheses are taken in order of more views, then smaller RMS; one whose blobs
-//      are all used by a taken point is the same point seen by another pair (merged);
-//      one that shares a blob with a taken point seen by MORE cameras is a ghost,
+//   4. hypotheses are taken in order of more views, then smaller RMS (multiview_accept.cpp);
+//      one whose blobs are all used by a taken point is the same point seen by another
+//      pair (merged); one that shares a blob with a taken point seen by MORE cameras is a ghost,
 //      rejected through the third view; one that shares a blob with a taken point seen
 //      by as many cameras stays, and both are flagged ambiguous (not reported): the
 //      identification resolves them by evidence, exactly as for two cameras.
@@ -144,6 +144,11 @@ class MultiViewMerger {
   void refine(int i, const Vec2* const* px) noexcept;
   // gate_px plus the marker's image radius in camera c at X_world (0: behind).
   double unfit_gate_px(int c, const Vec3& X_world) const noexcept;
+  // The same at depth z_mm (> 0) in camera c.
+  double unfit_gate_at_depth_px(int c, double z_mm) const noexcept {
+    return config_.gate_px +
+           cams_[static_cast<std::size_t>(c)].fx * config_.marker_radius_mm / z_mm;
+  }
   // Whether hypothesis i consists of taken point o's blobs and, in cameras where o has
   // no view, blobs within o's image (unfit_gate_px of its projection) only.
   bool is_unfit_pairing(int i, const Point3& o, const Vec2* const* px) const noexcept;
