@@ -5,14 +5,15 @@
 // of its outward normal: about half the ring) or by every camera (all_visible:1). Every
 // camera pair's triangulator plus the N-view merge (tests/stereo/rig_stereo_stage.h), in
 // several forms measured in the same run (the merge alone: a row minus PairsOnly):
-//  - BM_StereoRigIndexed: blobs undistorted once per camera, sorted sweep, indexed merge
-//    with claims (multiview.h: later pairs of a claimed marker are not extended);
-//  - BM_StereoRigReference: the same without claims (the reference merge);
+//  - BM_StereoRigIndexed: blobs undistorted once per camera, sorted sweep, indexed merge,
+//    pair by pair with settled blobs (multiview.h: later pairs skip two settled blobs);
+//  - BM_StereoRigReference: the same without settling (the reference merge);
 //  - BM_StereoRigPairUndistort: the same, every pair undistorting its blobs;
 //  - BM_StereoRigLinearMerge: the search before the index (pairs undistort, sorted
 //    sweep, linear-scan merge);
 //  - BM_StereoRigBruteForce: all n*m pairs and linear-scan merge.
-// The counter points_per_frame is the merge's output (the same in all four).
+// The counter points_per_frame is the merge's output; settled_per_frame the pairs of two
+// settled blobs (skipped by the pairs, or dropped by a merge given the lists).
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -62,8 +63,9 @@ void run_rig_stage(benchmark::State& state, const test::StagePath& path) {
       static_cast<double>(std::max<std::uint64_t>(1, stage.merger.counters().frames));
   state.counters["hypotheses_per_frame"] =
       static_cast<double>(stage.merger.counters().hypotheses) / frames_run;
-  state.counters["claimed_per_frame"] =
-      static_cast<double>(stage.merger.counters().claimed) / frames_run;
+  std::uint64_t settled = stage.merger.counters().settled;  // lists: the merge drops them
+  for (const StereoTriangulator& st : stage.pairs) settled += st.counters().settled_pairs;
+  state.counters["settled_per_frame"] = static_cast<double>(settled) / frames_run;
 }
 
 void BM_StereoRigIndexed(benchmark::State& s) { run_rig_stage(s, test::kIndexedPath); }

@@ -139,49 +139,4 @@ int BlobGrid::nearest(const Vec2& q, double radius_px, double& d2_out) const noe
   return best;
 }
 
-namespace {
-// One candidate of nearest_two(): the nearest (the scan's tie rule) and the runner-up.
-inline void take_two(int j, double d2, int& best, double& best_d2, double& second_d2) noexcept {
-  if (d2 < best_d2 || (d2 == best_d2 && j > best)) {
-    if (best >= 0) second_d2 = std::min(second_d2, best_d2);
-    best_d2 = d2;
-    best = j;
-  } else if (d2 < second_d2) {
-    second_d2 = d2;
-  }
-}
-}  // namespace
-
-int BlobGrid::nearest_two(const Vec2& q, double radius_px, double& d2_out,
-                          double& second_d2_out) const noexcept {
-  int best = -1;
-  double best_d2 = radius_px * radius_px;
-  double second_d2 = best_d2;
-  const double w =
-      std::abs(radius_px) * (1.0 + 1e-9) + 1e-9 + 1e-12 * (std::abs(q.x()) + std::abs(q.y()));
-  int x0 = 0, x1 = -1, y0 = 0, y1 = -1;
-  if (std::isfinite(w) && std::isfinite(q.x()) && std::isfinite(q.y())) {
-    x0 = grid_cell(q.x() - w, inv_cell_, gw_);
-    x1 = grid_cell(q.x() + w, inv_cell_, gw_);
-    y0 = grid_cell(q.y() - w, inv_cell_, gh_);
-    y1 = grid_cell(q.y() + w, inv_cell_, gh_);
-  }
-  if (x1 < x0 || (x1 - x0 + 1) * (y1 - y0 + 1) > kGridMaxQueryCells) {
-    for (int j = 0; j < n_; ++j) take_two(j, (px_[j] - q).squaredNorm(), best, best_d2, second_d2);
-  } else {
-    for (int y = y0; y <= y1; ++y) {
-      const std::size_t row = static_cast<std::size_t>(y) * static_cast<std::size_t>(gw_);
-      for (int x = x0; x <= x1; ++x) {
-        const Cell& cell = cells_[row + static_cast<std::size_t>(x)];
-        if (cell.stamp != generation_) continue;
-        for (int j = cell.head; j >= 0; j = next_[static_cast<std::size_t>(j)])
-          take_two(j, (px_[j] - q).squaredNorm(), best, best_d2, second_d2);
-      }
-    }
-  }
-  d2_out = best_d2;
-  second_d2_out = second_d2;
-  return best;
-}
-
 }  // namespace mocap

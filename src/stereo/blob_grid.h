@@ -15,7 +15,6 @@
 // a query of radius <= 8 px whose cell is unmarked has no blob within its radius (the
 // answer the scan gives: -1, r^2). Clamped like the grid, so blobs and queries outside
 // the image meet in the border cells.
-// nearest_two() also reports the second smallest distance (the merge's claims, multiview.h).
 // Capacity (max_blobs) is fixed at create(); build() ignores and counts further blobs.
 #pragma once
 
@@ -40,11 +39,6 @@ class BlobGrid {
   // of smallest d2, the largest j on ties; -1 when there is none. Writes its d2 (r^2
   // when there is none).
   int nearest(const Vec2& q, double radius_px, double& d2_out) const noexcept;
-
-  // nearest(), and the smallest d2 among the other blobs within the radius (r^2 when
-  // there is none) in second_d2_out: the margin by which the answer is the nearest.
-  int nearest_two(const Vec2& q, double radius_px, double& d2_out,
-                  double& second_d2_out) const noexcept;
 
   // The same by the linear scan over every indexed blob (the reference).
   int nearest_scan(const Vec2& q, double radius_px, double& d2_out) const noexcept;

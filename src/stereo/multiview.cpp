@@ -18,6 +18,8 @@ constexpr int kRefineIterations = 3;
 // A step below this ends the refinement: a thousandth of a marker's 3D noise (0.1 mm and
 // more at these ranges), so stopping there moves no point measurably.
 constexpr double kStepToleranceMm = 1e-4;
+// Views of a point that settles its blobs (multiview.h, "Settled blobs").
+constexpr int kSettleViews = 3;
 }  // namespace
 
 Expected<MultiViewMerger> MultiViewMerger::create(const Rig& rig, const MultiViewConfig& config) {
@@ -44,7 +46,7 @@ Expected<MultiViewMerger> MultiViewMerger::create(const Rig& rig, const MultiVie
   MultiViewConfig c = config;
   // Test-only switch (setup): run the reference in an unmodified binary (`mocap track`).
   if (const char* e = std::getenv("MOCAP_MULTIVIEW_REFERENCE"); e != nullptr && e[0] == '1')
-    c.claim_views = false;
+    c.settle_blobs = false;
   return MultiViewMerger(rig, c, std::move(grids), std::move(same_index).value());
 }
 
@@ -61,11 +63,8 @@ MultiViewMerger::MultiViewMerger(const Rig& rig, const MultiViewConfig& config,
       taken_by_(rig.cameras.size() * static_cast<std::size_t>(config.max_points_per_camera)),
       grids_(std::move(grids)),
       same_index_(std::move(same_index)),
-      claims_(static_cast<std::size_t>(config.max_hypotheses)),
-      claim_of_(rig.cameras.size() * static_cast<std::size_t>(config.max_points_per_camera)),
-      dup_head_(static_cast<std::size_t>(config.max_hypotheses)),
-      dup_next_(static_cast<std::size_t>(config.max_hypotheses)),
-      dup_tail_(static_cast<std::size_t>(config.max_hypotheses)) {}
+      settled_by_(rig.cameras.size() * static_cast<std::size_t>(config.max_points_per_camera), -1) {
+}
 
 double MultiViewMerger::unfit_gate_px(int c, const Vec3& X_world) const noexcept {
   const CameraModel& cam = cams_[static_cast<std::size_t>(c)];
@@ -182,112 +181,127 @@ bool MultiViewMerger::refit(Point3& p, const Vec2* const* px) const noexcept {
 
 bool MultiViewMerger::process(const Vec2* const* px, const int* n, const PointList* const* pairs,
                               int pair_count, PointList& out) noexcept {
+  begin_frame(px, n);
+  for (int p = 0; p < pair_count; ++p) add_pair(*pairs[p], px);
+  return finish(px, out);
+}
+
+void MultiViewMerger::begin_frame(const Vec2* const* px, const int* n) noexcept {
   ++counters_.frames;
-  out.clear();
-  bool complete = true;
-  if (camera_count() == 2) {  // one pair: its candidates are the answer
-    for (int p = 0; p < pair_count; ++p) {
-      for (const Point3& c : *pairs[p]) {
-        ++counters_.hypotheses;
-        if (!out.push_back(c)) {
-          ++counters_.point_overflow;
-          complete = false;
-          continue;
-        }
-        ++counters_.points;
-        if (c.ambiguous) ++counters_.ambiguous;
-      }
-    }
-    return complete;
-  }
+  complete_ = true;
+  count_ = 0;
+  if (camera_count() == 2) return;  // a pass-through: no grid, nothing settles
+  long blobs = 0;
   for (int c = 0; c < camera_count(); ++c) {
     const int m = grids_[static_cast<std::size_t>(c)].build(px[c], n[c]);
     if (n[c] > m) counters_.blob_overflow += static_cast<std::uint64_t>(n[c] - m);
+    blobs += m;
   }
-  int count = 0;
-  for (int p = 0; p < pair_count; ++p) {
-    for (const Point3& c : *pairs[p]) {
-      ++counters_.hypotheses;
-      if (count >= config_.max_hypotheses) {
-        ++counters_.hypothesis_overflow;
+  // The duplicate table sized for about one hypothesis per blob and other camera (a
+  // frame with more falls back to linear comparisons: the same result, counted nowhere).
+  same_index_.clear(static_cast<int>(
+      std::min<long>(config_.max_hypotheses, blobs * std::max(1, camera_count() - 1))));
+  std::fill(settled_by_.begin(), settled_by_.end(), -1);
+}
+
+// Steps 1-3 for hypothesis i: extension, the duplicate lookup, refinement; a point seen
+// by three or more cameras settles its views.
+void MultiViewMerger::merge_views(int i, const Vec2* const* px) noexcept {
+  Point3& h = hyp_[static_cast<std::size_t>(i)];
+  extend(i);
+  extended_[static_cast<std::size_t>(i)] = h.blob_index;
+  // The same point from another pair: the same blobs once extended.
+  const int same = same_as_earlier(i);
+  if (same >= 0) {
+    h = hyp_[static_cast<std::size_t>(same)];  // refined already
+    partial_views_[static_cast<std::size_t>(i)] = partial_views_[static_cast<std::size_t>(same)];
+  } else {
+    refine(i, px);
+  }
+  views_[static_cast<std::size_t>(i)] = h.blob_index.count();
+  if (config_.settle_blobs && views_[static_cast<std::size_t>(i)] >= kSettleViews) settle(i);
+}
+
+void MultiViewMerger::settle(int i) noexcept {
+  const BlobRefs& views = hyp_[static_cast<std::size_t>(i)].blob_index;
+  const std::size_t per_cam = static_cast<std::size_t>(config_.max_points_per_camera);
+  for (int c = 0; c < camera_count(); ++c) {
+    const int j = views[c];
+    if (j < 0 || j >= config_.max_points_per_camera) continue;
+    int& slot = settled_by_[static_cast<std::size_t>(c) * per_cam + static_cast<std::size_t>(j)];
+    if (slot < 0) slot = i;  // the first one keeps a blob
+  }
+}
+
+// The candidates of one pair, in order (hypothesis indices run on across the pairs of the
+// frame). A candidate of two blobs that EARLIER pairs settled (hypothesis index before
+// this pair's first) is none: the pairwise stage given SettledBlobs never makes it.
+void MultiViewMerger::add_pair(const PointList& pair, const Vec2* const* px) noexcept {
+  const int first = count_;
+  const std::size_t per_cam = static_cast<std::size_t>(config_.max_points_per_camera);
+  const bool pass_through = camera_count() == 2;  // one pair: its candidates are the answer
+  for (const Point3& c : pair) {
+    int cam[2] = {-1, -1}, k = 0;
+    for (int v = 0; v < camera_count() && k < 2; ++v)
+      if (c.blob_index[v] >= 0) cam[k++] = v;
+    if (k == 2 && config_.settle_blobs && !pass_through) {
+      int code[2];
+      for (int e = 0; e < 2; ++e) {
+        const int j = c.blob_index[cam[e]];
+        const int by = j < config_.max_points_per_camera
+                           ? settled_by_[static_cast<std::size_t>(cam[e]) * per_cam +
+                                         static_cast<std::size_t>(j)]
+                           : -1;
+        code[e] = by < first ? by : -1;  // settled by earlier pairs only
+      }
+      if (settled_pair(code[0], code[1])) {
+        ++counters_.settled;
+        continue;
+      }
+    }
+    ++counters_.hypotheses;
+    if (count_ >= config_.max_hypotheses) {
+      ++counters_.hypothesis_overflow;
+      complete_ = false;
+      continue;
+    }
+    const int i = count_++;
+    hyp_[static_cast<std::size_t>(i)] = c;
+    if (pass_through) continue;
+    merge_views(i, px);
+    order_[static_cast<std::size_t>(i)] =
+        AcceptKey{views_[static_cast<std::size_t>(i)], partial_views_[static_cast<std::size_t>(i)],
+                  hyp_[static_cast<std::size_t>(i)].reproj_px, i};
+  }
+}
+
+bool MultiViewMerger::finish(const Vec2* const* px, PointList& out) noexcept {
+  out.clear();
+  bool complete = complete_;
+  if (camera_count() == 2) {
+    for (int i = 0; i < count_; ++i) {
+      const Point3& c = hyp_[static_cast<std::size_t>(i)];
+      if (!out.push_back(c)) {
+        ++counters_.point_overflow;
         complete = false;
         continue;
       }
-      hyp_[static_cast<std::size_t>(count++)] = c;
+      ++counters_.points;
+      if (c.ambiguous) ++counters_.ambiguous;
     }
-  }
-  same_index_.clear(count);
-  const bool claims = config_.claim_views;
-  if (claims) {
-    claim_count_ = 0;
-    std::fill(claim_of_.begin(), claim_of_.end(), -1);
-  }
-  int keys = 0;  // hypotheses in order_ (claimed ones follow their claim, dup lists)
-  for (int i = 0; i < count; ++i) {
-    Point3& h = hyp_[static_cast<std::size_t>(i)];
-    dup_head_[static_cast<std::size_t>(i)] = -1;
-    const int claim_hyp = claims ? take_claimed(i) : -1;
-    if (claim_hyp < 0) {
-      extend(i);
-      extended_[static_cast<std::size_t>(i)] = h.blob_index;
-      // The same point from another pair: the same blobs once extended.
-      const int same = same_as_earlier(i);
-      if (same >= 0) {
-        h = hyp_[static_cast<std::size_t>(same)];  // refined already
-        partial_views_[static_cast<std::size_t>(i)] =
-            partial_views_[static_cast<std::size_t>(same)];
-      } else {
-        refine(i, px);
-        if (claims) make_claim(i);
-      }
-    }
-    views_[static_cast<std::size_t>(i)] = h.blob_index.count();
-    if (claim_hyp >= 0) {  // after its claim in index order (the sort's last key)
-      const auto j = static_cast<std::size_t>(claim_hyp);
-      dup_next_[static_cast<std::size_t>(i)] = -1;
-      if (dup_head_[j] < 0)
-        dup_head_[j] = i;
-      else
-        dup_next_[static_cast<std::size_t>(dup_tail_[j])] = i;
-      dup_tail_[j] = i;
-      continue;
-    }
-    order_[static_cast<std::size_t>(keys++)] =
-        AcceptKey{views_[static_cast<std::size_t>(i)], partial_views_[static_cast<std::size_t>(i)],
-                  h.reproj_px, i};
+    return complete;
   }
   // The keys sit side by side (not looked up in hyp_): the sort touches one small array.
-  const auto by_acceptance = [](const AcceptKey& a, const AcceptKey& b) {
+  std::sort(order_.begin(), order_.begin() + count_, [](const AcceptKey& a, const AcceptKey& b) {
     if (a.views != b.views) return a.views > b.views;
     // Then the cameras that see part of the ball there: a ghost (two blobs of different
     // markers on one epipolar line) has no image at all in the other cameras.
     if (a.partial != b.partial) return a.partial > b.partial;
     return a.reproj_px != b.reproj_px ? a.reproj_px < b.reproj_px : a.index < b.index;
-  };
-  std::sort(order_.begin(), order_.begin() + keys, by_acceptance);
-  if (keys < count && ties_a_claim(keys)) {
-    // A claim's key ties another's exactly (exact duplicate blobs): its claimed copies
-    // might interleave with that one; sort every hypothesis, as the reference does.
-    for (int i = 0; i < count; ++i) {
-      dup_head_[static_cast<std::size_t>(i)] = -1;
-      order_[static_cast<std::size_t>(i)] = AcceptKey{
-          views_[static_cast<std::size_t>(i)], partial_views_[static_cast<std::size_t>(i)],
-          hyp_[static_cast<std::size_t>(i)].reproj_px, i};
-    }
-    keys = count;
-    std::sort(order_.begin(), order_.begin() + keys, by_acceptance);
-  }
+  });
   std::fill(taken_by_.begin(), taken_by_.end(), -1);
-  for (int r = 0; r < keys; ++r) {
-    const int i = order_[static_cast<std::size_t>(r)].index;
-    const bool taken = accept(i, px, out, complete);
-    int d = dup_head_[static_cast<std::size_t>(i)];
-    if (d >= 0 && taken && owns_a_blob(out.size() - 1)) {
-      // Its copies' blobs are a taken point's hypothesis's: each one is merged.
-      for (; d >= 0; d = dup_next_[static_cast<std::size_t>(d)]) ++counters_.merged;
-    }
-    for (; d >= 0; d = dup_next_[static_cast<std::size_t>(d)]) accept(d, px, out, complete);
-  }
+  for (int r = 0; r < count_; ++r)
+    accept(order_[static_cast<std::size_t>(r)].index, px, out, complete);
   return complete;
 }
 

@@ -38,23 +38,23 @@
 // a hypothesis's blobs from a blob -> point table. MergeSearch::kExhaustive runs the
 // same steps by linear scans (every blob, every earlier hypothesis): the reference, with
 // an identical result (tests/stereo/test_stereo_index.cpp).
-// Claims (MultiViewConfig::claim_views, multiview_claims.cpp): most hypotheses are the
-// same marker from another pair, whose extension would find exactly the blobs an earlier
-// hypothesis found. The first hypothesis of a blob set with three or more views (after
-// its refinement) claims its blobs, with a margin per camera (computed when a later pair
-// first needs it): how far (mm) a point may move from the refined point before some
-// camera's extension could change (the nearest blob's lead over the gate, over the
-// runner-up, over the unfit gate; converted with the projection's Jacobian, twice over
-// for the non-linearity, within 0.2 % of the depth). A later pair whose two blobs are
-// both of one claim and whose own point lies within every
-// other camera's margin is given that hypothesis's result without extension: what the
-// extension and the duplicate lookup would have given it, bit for bit (the same blobs,
-// the same first equal set). Any other hypothesis (ghosts, pairs with blobs of two
-// claims, split blobs, merged images, unfit views that sit near the gate: zero margins)
-// takes the full treatment, so the acceptance sees the reference's hypotheses. The
-// reference (claim_views = false, or MOCAP_MULTIVIEW_REFERENCE=1 in the environment at
-// create(): a switch for end-to-end comparisons) extends every hypothesis; the output and
-// every counter but `claimed` are the same (tests/stereo/test_multiview_claims.cpp).
+// Settled blobs (MultiViewConfig::settle_blobs): most pairwise candidates are a marker
+// already found from an earlier pair, or a ghost made of two found markers' blobs. A
+// hypothesis that ends steps 1-3 with three or more views settles its blobs; a candidate
+// of a LATER camera pair whose two blobs are both settled is not a hypothesis at all
+// (counted in `settled`; the pairwise stage can skip triangulating it, SettledBlobs in
+// stereo_triangulator.h, with the same result): either both blobs are that point's (it
+// is found, by the pair that settled it) or each is another point's (a ghost, which the
+// acceptance would reject against the points seen by more cameras). Blobs of one pair's
+// candidates settle only the later pairs, so the result does not depend on the order of
+// candidates within a pair. A marker is still found from the first pair with an unsettled
+// blob; what settling can lose is a marker all of whose views are merged images of other
+// points in every camera pair, which no rule can tell apart. The reference
+// (settle_blobs = false, or
+// MOCAP_MULTIVIEW_REFERENCE=1 in the environment at create(): a switch for end-to-end
+// comparisons) takes every candidate (tests/stereo/test_multiview_settled.cpp).
+// A frame can be given as the pairs' candidate lists (process()) or pair by pair
+// (begin_frame(), add_pair(), finish()): the same result.
 // Capacity is fixed in create(); process() is noexcept and allocation-free; overflows
 // and rejections are counters. Each output point records its blob per camera.
 #pragma once
@@ -90,9 +90,9 @@ struct MultiViewConfig {
   // Cell of the per-camera blob grid (px): a few times the lookup radius (the gate plus
   // a ball's image radius), so a lookup visits one to four cells.
   double grid_cell_px = 64.0;
-  // Later pairs of a claimed marker take the claim's result without extension (the same
-  // result; see the design comment). false: every hypothesis is extended (the reference).
-  bool claim_views = true;
+  // Candidates of two blobs settled by earlier pairs are no hypotheses (see the design
+  // comment). false: every candidate is a hypothesis (the reference).
+  bool settle_blobs = true;
 };
 
 struct MultiViewCounters {
@@ -110,7 +110,7 @@ struct MultiViewCounters {
   std::uint64_t points = 0;               // emitted points
   std::uint64_t point_overflow = 0;       // emitted points beyond the output's capacity
   std::uint64_t blob_overflow = 0;        // blobs beyond max_points_per_camera (ignored)
-  std::uint64_t claimed = 0;              // hypotheses given a claim's result unextended
+  std::uint64_t settled = 0;              // candidates of two settled blobs (no hypothesis)
 };
 
 class MultiViewMerger {
@@ -124,6 +124,21 @@ class MultiViewMerger {
   // (hypotheses or output capacity); what was written is valid either way.
   bool process(const Vec2* const* px, const int* n, const PointList* const* pairs, int pair_count,
                PointList& out) noexcept;
+
+  // The same frame in parts, for a caller that runs the camera pairs one by one (3+
+  // cameras): begin_frame(), add_pair() after each pair, finish(). Between the pairs,
+  // settled_blobs(c) says which blobs of camera c the pairs so far settled (for the next
+  // pair's SettledBlobs). px and n as for process(), the same for every part of one
+  // frame. finish() returns what process() returns; an empty pair list is allowed.
+  void begin_frame(const Vec2* const* px, const int* n) noexcept;
+  void add_pair(const PointList& pair, const Vec2* const* px) noexcept;
+  bool finish(const Vec2* const* px, PointList& out) noexcept;
+  // Per blob of camera c (its first max_points_per_camera): the hypothesis that settled
+  // it this frame, -1: none. Valid until the next begin_frame(); all -1 in the reference.
+  const int* settled_blobs(int c) const noexcept {
+    return settled_by_.data() +
+           static_cast<std::size_t>(c) * static_cast<std::size_t>(config_.max_points_per_camera);
+  }
 
   // Refits p over exactly the views in p.blob_index (at least two; px as for process()):
   // Gauss-Newton on the real-pixel reprojection error from p.X_world; updates X_world and
@@ -158,20 +173,12 @@ class MultiViewMerger {
   bool split_from_owners(Point3& h, const int* owners, int n_owners, const PointList& out,
                          const Vec2* const* px) const noexcept;
 
-  // Claims: the first hypothesis of a blob set with 3+ views claims its blobs.
-  void make_claim(int i) noexcept;
-  // Gives hypothesis i its claim's result when that is what extension would give:
-  // returns the claim's hypothesis, or -1 (i untouched).
-  int take_claimed(int i) noexcept;
+  // Steps 1-3 for hypothesis i (its candidate in hyp_[i]).
+  void merge_views(int i, const Vec2* const* px) noexcept;
+  // Marks the views of hypothesis i (three or more) as settled by it.
+  void settle(int i) noexcept;
   // Step 4 for hypothesis i; true when it was emitted.
   bool accept(int i, const Vec2* const* px, PointList& out, bool& complete) noexcept;
-  // Whether two of the first `keys` sorted keys tie exactly and one has claimed copies.
-  bool ties_a_claim(int keys) const noexcept;
-  // Whether output point o owns a blob of its hypothesis (taken_by_).
-  bool owns_a_blob(int o) const noexcept;
-  // How far (mm) a point may move from X before camera c's extension changes; v: the
-  // claim's blob in c (-1: none). Adds 1 to unfit when c has an unfit view there.
-  double claim_margin_mm(int c, int v, const Vec3& X, int& unfit) const noexcept;
 
   std::vector<CameraModel> cams_;
   MultiViewConfig config_;
@@ -190,19 +197,9 @@ class MultiViewMerger {
   std::vector<int> taken_by_;     // [camera * max_points_per_camera + blob]: output index
   std::vector<BlobGrid> grids_;   // per camera: this frame's blobs by image cell
   BlobSetIndex same_index_;       // this frame's extended blob sets -> first hypothesis
-  struct Claim {
-    int hyp;  // the claiming hypothesis (first of its blob set)
-    // Per camera, computed when a later pair first needs it (-1: not yet; see
-    // claim_margin_mm), and whether that camera has an unfit view at the claim's point.
-    std::array<double, kMaxCameras> margin_mm;
-    std::array<std::uint8_t, kMaxCameras> unfit;
-  };
-  std::vector<Claim> claims_;  // this frame's claims
-  int claim_count_ = 0;
-  std::vector<int> claim_of_;  // [camera * max_points_per_camera + blob]: claim, -1: none
-  // Per hypothesis: its claimed copies in index order (accepted right after it, as the
-  // reference's sort puts them: the same key but the index), a list by head/next/tail.
-  std::vector<int> dup_head_, dup_next_, dup_tail_;
+  std::vector<int> settled_by_;   // [camera * max_points_per_camera + blob]: hypothesis, -1
+  int count_ = 0;                 // this frame's hypotheses so far
+  bool complete_ = true;          // nothing dropped this frame
   MultiViewCounters counters_;
 };
 

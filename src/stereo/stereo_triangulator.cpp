@@ -141,6 +141,10 @@ void StereoTriangulator::try_pair(int i, int j, PointList& out, int capacity) no
   const double tol = config_.epipolar_tolerance_px;
   if (!(d_a <= tol && d_b <= tol)) return;
   ++counters_.pairs_in_tolerance;
+  if (settled_.a != nullptr && settled_pair(settled_.a[i], settled_.b[j])) {
+    ++counters_.settled_pairs;
+    return;
+  }
 
   Vec2 sa_c, sb_c;
   niter2_correct(geometry_.F_s, a.s, b.s, sa_c, sb_c);
@@ -199,17 +203,19 @@ void StereoTriangulator::scan_range(int i, double lo, double hi, PointList& out,
 }
 
 bool StereoTriangulator::process(const Vec2* px_a, int n_a, const Vec2* px_b, int n_b,
-                                 PointList& out) noexcept {
+                                 PointList& out, SettledBlobs settled) noexcept {
   const bool bad =
       n_a < 0 || n_b < 0 || (n_a > 0 && px_a == nullptr) || (n_b > 0 && px_b == nullptr);
   // Bad input undistorts nothing; the view form counts it.
   return process(bad ? UndistortedBlobs{px_a, n_a} : undistort_a_.undistort(px_a, n_a),
-                 bad ? UndistortedBlobs{px_b, n_b} : undistort_b_.undistort(px_b, n_b), out);
+                 bad ? UndistortedBlobs{px_b, n_b} : undistort_b_.undistort(px_b, n_b), out,
+                 settled);
 }
 
 bool StereoTriangulator::process(const UndistortedBlobs& a, const UndistortedBlobs& b,
-                                 PointList& out) noexcept {
+                                 PointList& out, SettledBlobs settled) noexcept {
   out.clear();
+  settled_ = settled.a != nullptr && settled.b != nullptr ? settled : SettledBlobs{};
   ++counters_.frames;
   frame_overflow_ = false;
   const int r_a = a.received, r_b = b.received;

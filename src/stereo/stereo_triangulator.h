@@ -55,6 +55,7 @@ struct StereoCounters {
   std::array<std::uint64_t, 2> points_overflow{};   // blobs beyond max_points_per_camera
   std::array<std::uint64_t, 2> undistort_failed{};  // blobs whose undistortion failed
   std::uint64_t pairs_in_tolerance = 0;             // pairs passing the epipolar test
+  std::uint64_t settled_pairs = 0;                  // of them two settled blobs (not tried)
   std::uint64_t rejected_degenerate = 0;            // parallel rays (on the baseline / at infinity)
   std::uint64_t rejected_cheirality = 0;            // behind a camera
   std::uint64_t rejected_depth = 0;                 // outside [min_depth_mm, max_depth_mm]
@@ -75,6 +76,7 @@ struct StereoCounters {
       undistort_failed[i] += o.undistort_failed[i];
     }
     pairs_in_tolerance += o.pairs_in_tolerance;
+    settled_pairs += o.settled_pairs;
     rejected_degenerate += o.rejected_degenerate;
     rejected_cheirality += o.rejected_cheirality;
     rejected_depth += o.rejected_depth;
@@ -98,11 +100,13 @@ class StereoTriangulator {
   // Clears `out` and fills it with candidates (capacity min(out.capacity(),
   // max_candidates)). Returns false when something was dropped this frame (blob or
   // candidate overflow, bad input); the candidates written are valid either way.
-  bool process(const Vec2* px_a, int n_a, const Vec2* px_b, int n_b, PointList& out) noexcept;
+  bool process(const Vec2* px_a, int n_a, const Vec2* px_b, int n_b, PointList& out,
+               SettledBlobs settled = {}) noexcept;
   // The same from blobs undistorted once per camera and frame: `a` of camera_a(), `b` of
   // camera_b() (views of a BlobUndistorter of that rig camera with a capacity of at least
-  // max_points_per_camera). Identical result and counters.
-  bool process(const UndistortedBlobs& a, const UndistortedBlobs& b, PointList& out) noexcept;
+  // max_points_per_camera). Identical result and counters. `settled`: pairs not to try.
+  bool process(const UndistortedBlobs& a, const UndistortedBlobs& b, PointList& out,
+               SettledBlobs settled = {}) noexcept;
 
   const StereoCounters& counters() const noexcept { return counters_; }
   void reset_counters() noexcept { counters_ = StereoCounters{}; }
@@ -148,6 +152,7 @@ class StereoTriangulator {
   std::vector<SortKey> keys_b_;
   std::vector<std::uint16_t> use_a_;
   std::vector<std::uint16_t> use_b_;
+  SettledBlobs settled_;  // this frame's (process())
   int n_a_ = 0;
   int n_b_ = 0;
   bool frame_overflow_ = false;

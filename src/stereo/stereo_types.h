@@ -48,4 +48,17 @@ struct Point3 {
 // Candidates of one frame, indexed by int (the indices travel in int fields).
 using PointList = BoundedList<Point3, int>;
 
+// Blobs of the pair's cameras that earlier pairs of the frame already settled (the N-view
+// merge, multiview.h "Settled blobs"): per blob (the first max_points_per_camera of each
+// camera) the point that settled it, -1: none. A pair of two settled blobs is no
+// candidate (the stereo stage counts it in settled_pairs, the merge in settled): it is
+// that point again, or a ghost of two points. nullptr: nothing settled.
+inline bool settled_pair(int settled_a, int settled_b) noexcept {
+  return settled_a >= 0 && settled_b >= 0;
+}
+struct SettledBlobs {
+  const int* a = nullptr;
+  const int* b = nullptr;
+};
+
 }  // namespace mocap

@@ -72,7 +72,7 @@ static_assert(std::string_view(kDetectorFields[kDetectorFramesOverflow].name) ==
 // points_in_cam0 / _cam1 count the blobs given to each pair's first / second camera,
 // summed over the pairs: cameras 0 and 1 with two cameras; with more, the per-camera
 // blob counts are the detectors' (detect_cam<N>_*).
-inline constexpr std::array<CounterField<StereoCounters>, 14> kStereoFields = {{
+inline constexpr std::array<CounterField<StereoCounters>, 15> kStereoFields = {{
     MOCAP_COUNTER_FIELD(StereoCounters, frames),
     {"points_in_cam0",
      [](const StereoCounters& s) noexcept -> std::uint64_t { return s.points_in[0]; }},
@@ -87,6 +87,7 @@ inline constexpr std::array<CounterField<StereoCounters>, 14> kStereoFields = {{
        return s.undistort_failed[0] + s.undistort_failed[1];
      }},
     MOCAP_COUNTER_FIELD(StereoCounters, pairs_in_tolerance),
+    MOCAP_COUNTER_FIELD(StereoCounters, settled_pairs),
     MOCAP_COUNTER_FIELD(StereoCounters, rejected_degenerate),
     MOCAP_COUNTER_FIELD(StereoCounters, rejected_cheirality),
     MOCAP_COUNTER_FIELD(StereoCounters, rejected_depth),
@@ -113,7 +114,7 @@ inline constexpr std::array<CounterField<MultiViewCounters>, 15> kMultiViewField
     MOCAP_COUNTER_FIELD(MultiViewCounters, points),
     MOCAP_COUNTER_FIELD(MultiViewCounters, point_overflow),
     MOCAP_COUNTER_FIELD(MultiViewCounters, blob_overflow),
-    MOCAP_COUNTER_FIELD(MultiViewCounters, claimed),
+    MOCAP_COUNTER_FIELD(MultiViewCounters, settled),
 }};
 
 // Reported as identify_<name>.

@@ -184,18 +184,20 @@ void FrameProcessor::triangulate(FrameOutput& out) noexcept {
   for (int c = 0; c < n_cams; ++c)
     if (out.camera_present[static_cast<std::size_t>(c)])
       views[c] = undistorters_[static_cast<std::size_t>(c)].undistort(px[c], n[c]);
-  const PointList* lists[kMaxCameraPairs] = {};
-  int listed = 0;
+  // Pair by pair into the merge: a pair of blobs that earlier pairs settled (both in
+  // points seen by three or more cameras) is not triangulated again.
+  merger_.begin_frame(px, n);
   for (std::size_t k = 0; k < pairs_.size(); ++k) {
     StereoTriangulator& st = pairs_[k];
     const int a = st.camera_a(), b = st.camera_b();
     if (!out.camera_present[static_cast<std::size_t>(a)] ||
         !out.camera_present[static_cast<std::size_t>(b)])
       continue;
-    st.process(views[a], views[b], pair_points_[k]);
-    lists[listed++] = &pair_points_[k];
+    st.process(views[a], views[b], pair_points_[k],
+               SettledBlobs{merger_.settled_blobs(a), merger_.settled_blobs(b)});
+    merger_.add_pair(pair_points_[k], px);
   }
-  merger_.process(px, n, lists, listed, out.points);
+  merger_.finish(px, out.points);
   StereoCounters total;
   for (const StereoTriangulator& st : pairs_) total += st.counters();
   stereo_total_ = total;

@@ -4,17 +4,16 @@
 // Cameras: the rig's 2..kMaxCameras cameras all take part. Two cameras: one stereo pair
 // (stereo_triangulator.h), exactly as the paper. More: one triangulator per camera pair
 // proposes candidates and the MultiViewMerger (multiview.h) merges them into N-view
-// points refined over every camera that sees them; a view whose blob does not look like
-// a whole marker (marker_shape.h) is then left out of the point when two or more whole
-// views remain, so an occluded view no longer biases a point other cameras see clearly.
-// A camera whose frame is missing takes no part in that frame: with two cameras the
-// frame yields no 3D points (spec); with more, the others still triangulate (at least
-// two present).
-// Immutable configuration plus preallocated workspace: create() validates and allocates
-// every buffer from the stated bounds; the per-frame calls are noexcept, allocate
-// nothing and never throw. The live pipeline calls the stages separately (detect_camera()
-// on the detect threads, then process_blobs()); `process()` runs them in sequence and
-// times them.
+// points refined over every camera that sees them, pair by pair (a pair does not
+// triangulate two blobs earlier pairs settled: multiview.h, "Settled blobs"); a view whose blob
+// does not look like a whole marker (marker_shape.h) is then left out of the point when two or more
+// whole views remain, so an occluded view no longer biases a point other cameras see clearly. A
+// camera whose frame is missing takes no part in that frame: with two cameras the frame yields no
+// 3D points (spec); with more, the others still triangulate (at least two present). Immutable
+// configuration plus preallocated workspace: create() validates and allocates every buffer from the
+// stated bounds; the per-frame calls are noexcept, allocate nothing and never throw. The live
+// pipeline calls the stages separately (detect_camera() on the detect threads, then
+// process_blobs()); `process()` runs them in sequence and times them.
 #pragma once
 
 #include <array>

@@ -65,9 +65,11 @@ struct SceneOptions {
   double facing_deg = 180.0;
 };
 
-// One frame: per camera, the blobs (shuffled).
+// One frame: per camera, the blobs (shuffled). markers_world (optional) receives every
+// marker's position, the second balls of twins included.
 inline std::vector<std::vector<Vec2>> humanoid_frame(const Rig& rig, const SceneOptions& o,
-                                                     std::mt19937& rng) {
+                                                     std::mt19937& rng,
+                                                     std::vector<Vec3>* markers_world = nullptr) {
   std::uniform_real_distribution<double> u(-1.0, 1.0), u01(0.0, 1.0);
   std::normal_distribution<double> noise(0.0, o.noise_px);
   std::vector<std::vector<Vec2>> px(rig.cameras.size());
@@ -86,6 +88,10 @@ inline std::vector<std::vector<Vec2>> humanoid_frame(const Rig& rig, const Scene
       Vec3 d(u(rng), u(rng), u(rng));
       while (d.squaredNorm() < 1e-6) d = Vec3(u(rng), u(rng), u(rng));
       X2 = X + (14.0 + 6.0 * u01(rng)) * d.normalized();
+    }
+    if (markers_world != nullptr) {
+      markers_world->push_back(X);
+      if (twin) markers_world->push_back(X2);
     }
     for (std::size_t c = 0; c < rig.cameras.size(); ++c) {
       Vec2 p;

@@ -2,7 +2,9 @@
 // as FrameProcessor runs it (one StereoTriangulator per camera pair, then the
 // MultiViewMerger), with each choice of the search open: blobs undistorted once per camera
 // (BlobUndistorter views) or by every pair, the pairs' sorted sweep or all n*m pairs, the
-// merge's index or its linear scans, with or without claims (multiview.h).
+// merge's index or its linear scans, settled blobs or the reference (multiview.h), and
+// the frame given pair by pair (each pair skips the pairs of settled blobs: FrameProcessor's
+// form) or as the pairs' lists (the merge skips those candidates: the same result).
 #pragma once
 
 #include <array>
@@ -18,26 +20,28 @@ struct StagePath {
   bool shared_undistortion = true;
   MatchMethod match = MatchMethod::kSortedSweep;
   MergeSearch merge = MergeSearch::kIndexed;
-  bool run_merge = true;  // false: the pairs only (benchmarks: where the time goes)
-  bool claims = true;     // MultiViewConfig::claim_views (false: the reference merge)
+  bool run_merge = true;     // false: the pairs only (benchmarks: where the time goes)
+  bool settle = true;        // MultiViewConfig::settle_blobs (false: the reference merge)
+  bool pair_by_pair = true;  // begin_frame/add_pair/finish with SettledBlobs; else process()
 };
-// Today's path: undistorted once per camera, sorted sweep, indexed merge.
+// Today's path: undistorted once per camera, sorted sweep, indexed merge, pair by pair.
 inline constexpr StagePath kIndexedPath{};
 // The same search with every pair undistorting its blobs (the pointer form of process()).
 inline constexpr StagePath kPairUndistortPath{false, MatchMethod::kSortedSweep,
                                               MergeSearch::kIndexed};
-// The search before the index: pairs undistort, sorted sweep, linear-scan merge.
-inline constexpr StagePath kLinearMergePath{false, MatchMethod::kSortedSweep,
-                                            MergeSearch::kExhaustive, true, false};
-// Today's search with the reference merge: every hypothesis extended (no claims).
+// The search before the index: pairs undistort, sorted sweep, linear-scan merge, the
+// pairs' lists given at once.
+inline constexpr StagePath kLinearMergePath{
+    false, MatchMethod::kSortedSweep, MergeSearch::kExhaustive, true, true, false};
+// Today's search with the reference merge: every candidate a hypothesis (no settling).
 inline constexpr StagePath kReferencePath{true, MatchMethod::kSortedSweep, MergeSearch::kIndexed,
                                           true, false};
-// The pairs of the indexed path alone.
+// The pairs of the indexed path alone (nothing settles without the merge).
 inline constexpr StagePath kPairsOnlyPath{true, MatchMethod::kSortedSweep, MergeSearch::kIndexed,
-                                          false};
-// Brute force of everything: all n*m pairs, linear-scan merge.
-inline constexpr StagePath kBruteForcePath{false, MatchMethod::kExhaustive,
-                                           MergeSearch::kExhaustive, true, false};
+                                          false, false};
+// Brute force of everything: all n*m pairs, linear-scan merge, the lists at once.
+inline constexpr StagePath kBruteForcePath{
+    false, MatchMethod::kExhaustive, MergeSearch::kExhaustive, true, true, false};
 
 struct RigStereoStage {
   StagePath path;
@@ -52,7 +56,7 @@ struct RigStereoStage {
     c.marker_radius_mm = 7.0;
     c.max_hypotheses = 1024 * static_cast<int>(cameras * (cameras - 1) / 2);  // as FrameProcessor
     c.search = path.merge;
-    c.claim_views = path.claims;
+    c.settle_blobs = path.settle;
     return c;
   }
 
@@ -81,17 +85,24 @@ struct RigStereoStage {
       n[c] = static_cast<int>(px[c].size());
       if (path.shared_undistortion) views[c] = undistort[c].undistort(p[c], n[c]);
     }
+    const bool by_pair = path.run_merge && path.pair_by_pair;
+    if (by_pair) merger.begin_frame(p, n);
     const PointList* lists[kMaxCameraPairs] = {};
     for (std::size_t k = 0; k < pairs.size(); ++k) {
-      const auto a = static_cast<std::size_t>(pairs[k].camera_a());
-      const auto b = static_cast<std::size_t>(pairs[k].camera_b());
+      const int a = pairs[k].camera_a(), b = pairs[k].camera_b();
+      const SettledBlobs settled =
+          by_pair ? SettledBlobs{merger.settled_blobs(a), merger.settled_blobs(b)} : SettledBlobs{};
       if (path.shared_undistortion)
-        pairs[k].process(views[a], views[b], pair_out[k]);
+        pairs[k].process(views[a], views[b], pair_out[k], settled);
       else
-        pairs[k].process(p[a], n[a], p[b], n[b], pair_out[k]);
+        pairs[k].process(p[a], n[a], p[b], n[b], pair_out[k], settled);
       lists[k] = &pair_out[k];
+      if (by_pair) merger.add_pair(pair_out[k], p);
     }
-    if (path.run_merge) merger.process(p, n, lists, static_cast<int>(pairs.size()), out);
+    if (by_pair)
+      merger.finish(p, out);
+    else if (path.run_merge)
+      merger.process(p, n, lists, static_cast<int>(pairs.size()), out);
   }
 };
 

@@ -203,7 +203,8 @@ TEST(MultiView, FourCamerasFindEveryPointSeenThreeTimesWithoutGhosts) {
     std::fprintf(stderr, "found %d of %d, spurious %d, rmse %.4f mm (pairs %.4f mm)\n", found,
                  expected, spurious, rmse_merged, rmse_pair);
   EXPECT_GT(st.merger.counters().views_added, 0u);
-  EXPECT_GT(st.merger.counters().merged, 0u);
+  // The same marker from later pairs: their candidates of two settled blobs are none.
+  EXPECT_GT(st.merger.counters().settled, 0u);
 }
 
 TEST(MultiView, ProcessAllocatesNothing) {

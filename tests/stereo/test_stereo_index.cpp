@@ -3,9 +3,11 @@
 // linear scans they replace. Property tests over many random scenes of "the whole robot"
 // (2..8 cameras on a ring 2.5-3.5 m around a humanoid volume, 5..130 markers, views
 // missing, stray, split and duplicate blobs):
-//  - the new path (undistorted once per camera, sorted sweep, indexed merge) and the
-//    previous one (each pair undistorts, linear-scan merge) agree bit for bit: every
-//    point, in order (X_world, errors, blob per camera, flags), and every counter;
+//  - the new path (undistorted once per camera, sorted sweep, indexed merge, pair by
+//    pair: the pairs skip settled candidates) and the previous one (each pair undistorts,
+//    linear-scan merge, the pairs' lists at once: the merge skips them) agree bit for bit:
+//    every point, in order (X_world, errors, blob per camera, flags), and every counter
+//    but `settled`; the pairs skipped every candidate the merge found settled;
 //  - both agree with the brute force of everything (all n*m pairs, linear scans) on the
 //    set of points, in scenes without exact duplicate blobs (with them, hypotheses tie
 //    exactly and the merge breaks the tie by the pairs' candidate order, which differs
@@ -53,9 +55,10 @@ std::vector<Point3> sorted(const PointList& l) {
   return v;
 }
 
-// Every counter but `claimed` (claims are an optimisation of the reference's merge).
+// Every counter but `settled` (pair by pair, the pairs skip those candidates: the merge
+// never sees them).
 bool same_counters(MultiViewCounters a, MultiViewCounters b) {
-  a.claimed = b.claimed = 0;
+  a.settled = b.settled = 0;
   return std::memcmp(&a, &b, sizeof(a)) == 0;
 }
 
@@ -83,6 +86,7 @@ TEST(StereoIndex, IndexedPathEqualsThePreviousAndTheBruteForceOnRandomScenes) {
     so.duplicate = s % 3 == 2 ? 0.02 : 0.0;
     test::RigStereoStage fresh(rig, test::kIndexedPath), previous(rig, test::kLinearMergePath),
         brute(rig, test::kBruteForcePath), pair_undistort(rig, test::kPairUndistortPath);
+    std::uint64_t skipped_before = 0, settled_before = 0;
     for (int f = 0; f < 2; ++f) {
       const auto px = test::humanoid_frame(rig, so, rng);
       fresh.run(px);
@@ -91,16 +95,25 @@ TEST(StereoIndex, IndexedPathEqualsThePreviousAndTheBruteForceOnRandomScenes) {
       pair_undistort.run(px);
       SCOPED_TRACE(::testing::Message() << "scene " << s << " frame " << f << ", " << ro.cameras
                                         << " cameras, " << so.markers << " markers");
+      std::uint64_t skipped = 0;  // settled pairs the fresh path's pairs did not try
       for (std::size_t k = 0; k < fresh.pairs.size(); ++k) {
+        // The shared undistortion equals every pair's own (both pair by pair).
         const PointList& a = fresh.pair_out[k];
-        const PointList& b = previous.pair_out[k];
-        ASSERT_EQ(a.size(), b.size()) << "pair " << k;
-        for (int i = 0; i < a.size(); ++i) ASSERT_TRUE(identical(a[i], b[i])) << "pair " << k;
-        const auto sa = sorted(a), sb = sorted(brute.pair_out[k]);  // the same pairs
+        const PointList& u = pair_undistort.pair_out[k];
+        ASSERT_EQ(a.size(), u.size()) << "pair " << k;
+        for (int i = 0; i < a.size(); ++i) ASSERT_TRUE(identical(a[i], u[i])) << "pair " << k;
+        ASSERT_TRUE(same_counters(fresh.pairs[k].counters(), pair_undistort.pairs[k].counters()));
+        skipped += fresh.pairs[k].counters().settled_pairs;
+        // The sweep finds the n*m loop's pairs (both given as lists: every pair tried).
+        const auto sa = sorted(previous.pair_out[k]), sb = sorted(brute.pair_out[k]);
         ASSERT_EQ(sa.size(), sb.size()) << "pair " << k;
         for (std::size_t i = 0; i < sa.size(); ++i) ASSERT_TRUE(identical(sa[i], sb[i]));
-        ASSERT_TRUE(same_counters(fresh.pairs[k].counters(), previous.pairs[k].counters()));
       }
+      // The candidates the merge of the lists found settled, the pairs skipped (with the
+      // pairs of settled blobs that a later check of the pair would have rejected).
+      ASSERT_GE(skipped - skipped_before, previous.merger.counters().settled - settled_before);
+      skipped_before = skipped;
+      settled_before = previous.merger.counters().settled;
       ASSERT_EQ(fresh.out.size(), previous.out.size());
       for (int i = 0; i < fresh.out.size(); ++i)
         ASSERT_TRUE(identical(fresh.out[i], previous.out[i])) << "point " << i;
