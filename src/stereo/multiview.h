@@ -192,12 +192,13 @@ class MultiViewMerger {
   BlobSetIndex same_index_;       // this frame's extended blob sets -> first hypothesis
   struct Claim {
     int hyp;  // the claiming hypothesis (first of its blob set)
-    // Per camera, computed when a later pair first needs it (-1: not yet; see
-    // claim_margin_mm), and whether that camera has an unfit view at the claim's point.
-    std::array<double, kMaxCameras> margin_mm;
-    std::array<std::uint8_t, kMaxCameras> unfit;
   };
   std::vector<Claim> claims_;  // this frame's claims
+  // Per claim and camera ([claim * camera_count() + camera]), computed when a later pair
+  // first needs it (-1: not yet; see claim_margin_mm), and whether that camera has an
+  // unfit view at the claim's point.
+  std::vector<double> claim_margin_mm_;
+  std::vector<std::uint8_t> claim_unfit_;
   int claim_count_ = 0;
   std::vector<int> claim_of_;  // [camera * max_points_per_camera + blob]: claim, -1: none
   // Per hypothesis: its claimed copies in index order (accepted right after it, as the

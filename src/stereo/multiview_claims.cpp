@@ -78,8 +78,11 @@ void MultiViewMerger::make_claim(int i) noexcept {
   if (set.count() < 3 || claim_count_ >= static_cast<int>(claims_.size())) return;
   Claim& claim = claims_[static_cast<std::size_t>(claim_count_)];
   claim.hyp = i;
-  claim.margin_mm.fill(-1.0);  // computed when first needed (take_claimed)
-  claim.unfit.fill(0);
+  const auto first = static_cast<std::size_t>(claim_count_ * camera_count());
+  std::fill_n(claim_margin_mm_.begin() + static_cast<std::ptrdiff_t>(first), camera_count(),
+              -1.0);  // computed when first needed (take_claimed)
+  std::fill_n(claim_unfit_.begin() + static_cast<std::ptrdiff_t>(first), camera_count(),
+              std::uint8_t{0});
   const std::size_t per_cam = static_cast<std::size_t>(config_.max_points_per_camera);
   for (int c = 0; c < camera_count(); ++c) {
     const int j = set[c];
@@ -111,16 +114,17 @@ int MultiViewMerger::take_claimed(int i) noexcept {
   const auto j = static_cast<std::size_t>(claim.hyp);
   const double moved_mm = (h.X_world - hyp_[j].X_world).norm();
   int unfit = 0;
+  double* const margin_mm = claim_margin_mm_.data() + a * camera_count();
+  std::uint8_t* const unfit_view = claim_unfit_.data() + a * camera_count();
   for (int c = 0; c < camera_count(); ++c) {
     if (c == cam[0] || c == cam[1]) continue;  // the pair's own views: not extended
-    const auto cc = static_cast<std::size_t>(c);
-    if (claim.margin_mm[cc] < 0.0) {  // first need: the margin at the claim's point
+    if (margin_mm[c] < 0.0) {                  // first need: the margin at the claim's point
       int u = 0;
-      claim.margin_mm[cc] = claim_margin_mm(c, extended_[j][c], hyp_[j].X_world, u);
-      claim.unfit[cc] = static_cast<std::uint8_t>(u);
+      margin_mm[c] = claim_margin_mm(c, extended_[j][c], hyp_[j].X_world, u);
+      unfit_view[c] = static_cast<std::uint8_t>(u);
     }
-    if (!(moved_mm <= claim.margin_mm[cc])) return -1;
-    unfit += claim.unfit[cc];  // cam[0], cam[1] are views of the claim: never unfit
+    if (!(moved_mm <= margin_mm[c])) return -1;
+    unfit += unfit_view[c];  // cam[0], cam[1] are views of the claim: never unfit
   }
   // What extension and the duplicate lookup give: the claim's blobs, its hypothesis.
   const BlobRefs& set = extended_[j];
