@@ -1,7 +1,7 @@
 // Design: the simulated backend of the Camera interface, so that the live pipeline
 // runs end to end without hardware (`mocap run` with no configuration).
 //   SimFrameLoop : setup only. Renders `frames` frames of the built-in scenario (the
-//                  simulator's motion, every camera of the scene: 2..8) into owned
+//                  simulator's motion, every camera of the scene: 2..32) into owned
 //                  Images, once. Memory: frames x cameras x width x height bytes, e.g.
 //                  200 x 2 x 1032 x 776 = 320 MB (8-bit); tests use short loops.
 //                  Immutable afterwards, shared.

@@ -133,15 +133,18 @@ void make_frame_result(std::uint64_t sequence, std::int64_t capture_ns, const Ta
 
   // Each camera's blobs, and what they became: a labelled marker, a point, or nothing.
   const int cameras = std::min(static_cast<int>(out.blobs.size()), publish::kMaxResultCameras);
+  const int per_camera = publish::result_blobs_per_camera(cameras);
   result.camera_count = cameras;
   for (int c = 0; c < cameras; ++c) {
     const detect::BlobList& blobs = out.blobs[static_cast<std::size_t>(c)];
     publish::CameraBlobs& cb = result.cameras[static_cast<std::size_t>(c)];
     cb.present = out.camera_present[static_cast<std::size_t>(c)] ? 1 : 0;
-    cb.count = std::min(static_cast<int>(blobs.size()), publish::kMaxResultBlobs);
+    cb.count = std::min(static_cast<int>(blobs.size()), per_camera);
+    cb.first = c * per_camera;
+    publish::ResultBlob* const kept = result.blobs_of(c);
     for (int i = 0; i < cb.count; ++i) {
       const detect::Blob& b = blobs[static_cast<std::size_t>(i)];
-      publish::ResultBlob& r = cb.blobs[static_cast<std::size_t>(i)];
+      publish::ResultBlob& r = kept[i];
       r = publish::ResultBlob{};
       r.x_px = static_cast<float>(b.x_px);
       r.y_px = static_cast<float>(b.y_px);
@@ -153,24 +156,26 @@ void make_frame_result(std::uint64_t sequence, std::int64_t capture_ns, const Ta
     const std::int16_t bi = out.points[point].blob_index[static_cast<std::size_t>(c)];
     const publish::CameraBlobs& cb = result.cameras[static_cast<std::size_t>(c)];
     if (bi < 0 || bi >= cb.count) return nullptr;
-    return &result.cameras[static_cast<std::size_t>(c)].blobs[static_cast<std::size_t>(bi)];
+    return result.blobs_of(c) + bi;
   };
   for (int p = 0; p < out.points.size(); ++p) {
     if (!out.points[p].reported) continue;
-    for (int c = 0; c < cameras; ++c) {
+    out.points[p].blob_index.for_each([&](int c, int) {
+      if (c >= cameras) return;
       if (publish::ResultBlob* r = blob_of(p, c))
         r->use = static_cast<std::uint8_t>(publish::BlobUse::kPoint);
-    }
+    });
   }
   for (int i = 0; i < labelled.count; ++i) {
     const LabelledMarker& l = labelled.items[static_cast<std::size_t>(i)];
-    for (int c = 0; c < cameras; ++c) {
-      publish::ResultBlob* r = blob_of(l.point, c);
-      if (r == nullptr) continue;
+    if (l.point < 0 || l.point >= out.points.size()) continue;
+    out.points[l.point].blob_index.for_each([&](int c, int) {
+      publish::ResultBlob* r = c < cameras ? blob_of(l.point, c) : nullptr;
+      if (r == nullptr) return;
       r->use = static_cast<std::uint8_t>(publish::BlobUse::kMarker);
       r->body = static_cast<std::uint8_t>(std::clamp<int>(l.body, 0, 255));
       r->marker = static_cast<std::uint8_t>(std::clamp<int>(l.marker, 0, 255));
-    }
+    });
   }
 }
 

@@ -1,7 +1,7 @@
 // Design: THE table of the live pipeline's threads (PX4 style: one place to read and
 // tune every thread's CPU, SCHED_FIFO priority and input ring depth). docs/pipeline.md
 // documents it; `mocap run --config` may override it per stage. One row per stage
-// kind; the detect row is the RULE for the rig's detect stages (one per camera, 2..8):
+// kind; the detect row is the RULE for the rig's detect stages (one per camera, 2..32):
 //   detect stage k: thread "mocap-detect<k>", CPU (row cpu + k) % cpu_count (row cpu -1:
 //   not pinned), the row's priority and ring depth, unless a per-camera override
 //   (DetectOverride, `pipeline.stages.detect<k>`) sets them.

@@ -66,9 +66,12 @@ std::string encode_blob_overlay(const FoxgloveScene& scene, const publish::Frame
   const bool have = camera < std::clamp(frame.camera_count, 0, publish::kMaxResultCameras);
   const publish::CameraBlobs* blobs =
       have ? &frame.cameras[static_cast<std::size_t>(camera)] : nullptr;
-  const int n = blobs != nullptr ? std::clamp(blobs->count, 0, publish::kMaxResultBlobs) : 0;
+  const int first =
+      blobs != nullptr ? std::clamp(blobs->first, 0, publish::kMaxResultBlobTotal) : 0;
+  const int n =
+      blobs != nullptr ? std::clamp(blobs->count, 0, publish::kMaxResultBlobTotal - first) : 0;
   for (int i = 0; i < n; ++i) {
-    const publish::ResultBlob& b = blobs->blobs[static_cast<std::size_t>(i)];
+    const publish::ResultBlob& b = frame.blobs[static_cast<std::size_t>(first + i)];
     if (!std::isfinite(b.x_px) || !std::isfinite(b.y_px) || !std::isfinite(b.diameter_px)) continue;
     const double cx = static_cast<double>(b.x_px) / kBlobOverlayScale;
     const double cy = static_cast<double>(b.y_px) / kBlobOverlayScale;

@@ -10,7 +10,7 @@
 //             (body name labels), "joints" (joint centres as spheres, hinge axes as
 //             arrows, of joints whose parent body was found).
 //   /joints   mocap.JointAngles: name, type, valid, angles (rad), solved_by, sd (rad).
-//   /<camera>/blobs  foxglove.RawImage, one per rig camera (2..8), at a low rate: the blob
+//   /<camera>/blobs  foxglove.RawImage, one per rig camera (2..32), at a low rate: the blob
 //             overlay for aiming (blob_overlay.h).
 // Timestamps: stamp_ns is the capture time on the wall clock (CLOCK_REALTIME, ns).
 #pragma once

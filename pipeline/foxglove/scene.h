@@ -48,7 +48,7 @@ struct FoxgloveScene {
   double marker_diameter_mm = 12.0;
   std::vector<SceneBody> bodies;
   std::vector<SceneJoint> joints;    // empty without a joint model
-  std::vector<SceneCamera> cameras;  // every rig camera (2..8); empty without a rig
+  std::vector<SceneCamera> cameras;  // every rig camera (2..32); empty without a rig
 };
 
 // The colour of body i of n: evenly spaced, saturated hues (deterministic).

@@ -19,13 +19,20 @@
 namespace mocap::publish {
 
 // The compiled capacities of one frame's result (docs/formats.md, "Capacities", with their
-// memory: sizeof(FrameResult) is 55.6 KiB). The builder (pipeline/
+// memory: sizeof(FrameResult) is 57.6 KiB). The builder (pipeline/
 // frame_result_builder.cpp) asserts that they hold everything the tracker produces.
 inline constexpr int kMaxResultBodies = 32;            // = identify's kMaxBodies
 inline constexpr int kMaxResultMarkers = 512;          // labelled markers per frame (32 x 16)
 inline constexpr int kMaxResultPoints = 512;           // 3D points per frame (= kMaxPoints)
 inline constexpr int kMaxResultCameras = kMaxCameras;  // cameras with blobs
 inline constexpr int kMaxResultBlobs = 256;  // blobs per camera (= stereo max_points_per_camera)
+// The blobs of all cameras together: 8 cameras keep kMaxResultBlobs each; a larger rig
+// shares them (result_blobs_per_camera), so the result does not grow with kMaxCameras.
+inline constexpr int kMaxResultBlobTotal = 8 * kMaxResultBlobs;
+// Blobs kept per camera of a rig of `cameras` cameras (256 up to 8 cameras, 64 at 32).
+constexpr int result_blobs_per_camera(int cameras) noexcept {
+  return cameras <= 8 ? kMaxResultBlobs : kMaxResultBlobTotal / cameras;
+}
 
 struct ResultBody {
   std::uint8_t found = 0;           // 1: the body was found in this frame
@@ -73,11 +80,13 @@ struct ResultBlob {
   std::uint8_t reserved = 0;
 };
 
+// A camera's blobs are FrameResult::blobs[first, first + count) (FrameResult::blobs_of);
+// a camera with more keeps its first result_blobs_per_camera(camera_count).
 struct CameraBlobs {
-  std::int32_t count = 0;    // blobs[0, count); a camera with more keeps its first 256
+  std::int32_t count = 0;
   std::uint8_t present = 0;  // 1: the camera's frame arrived
   std::uint8_t reserved[3] = {0, 0, 0};
-  std::array<ResultBlob, kMaxResultBlobs> blobs{};
+  std::int32_t first = 0;
 };
 
 struct FrameResult {
@@ -90,6 +99,15 @@ struct FrameResult {
   std::array<ResultPoint, kMaxResultPoints> points{};
   std::int32_t camera_count = 0;  // the rig's cameras, in rig order
   std::array<CameraBlobs, kMaxResultCameras> cameras{};
+  std::array<ResultBlob, kMaxResultBlobTotal> blobs{};
+
+  // Camera c's blobs ([0, cameras[c].count)); c < camera_count.
+  const ResultBlob* blobs_of(int c) const noexcept {
+    return blobs.data() + cameras[static_cast<std::size_t>(c)].first;
+  }
+  ResultBlob* blobs_of(int c) noexcept {
+    return blobs.data() + cameras[static_cast<std::size_t>(c)].first;
+  }
 };
 
 static_assert(std::is_trivially_copyable_v<FrameResult>, "FrameResult lives in slots");

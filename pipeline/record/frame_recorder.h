@@ -123,8 +123,9 @@ class FrameRecorder final : public pipeline::FrameTap, public pipeline::BlobTap 
     std::int32_t kept = -1;     // blobs: index of the kept image's buffer, -1 none
   };
   struct Unit {  // one frame to write: slot index per camera, -1 if none
+    Unit() noexcept { slot.fill(-1); }
     std::int64_t frame = 0;
-    std::int32_t slot[kMaxCameras] = {-1, -1, -1, -1, -1, -1, -1, -1};
+    std::array<std::int32_t, kMaxCameras> slot;
   };
 
   explicit FrameRecorder(const RecorderOptions& options, RecordingFiles files);

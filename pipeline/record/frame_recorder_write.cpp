@@ -27,7 +27,8 @@ void FrameRecorder::write_unit(const Unit& u) {
     if (first_frame_ < 0) first_frame_ = u.frame;
     const std::int64_t number = u.frame - first_frame_;
     const int n = camera_count();
-    int written[kMaxCameras] = {-1, -1, -1, -1, -1, -1, -1, -1};
+    std::array<int, kMaxCameras> written;
+    written.fill(-1);
     bool has[kMaxCameras] = {};  // the camera's image (or blob list) is in the recording
     Expected<void> r;
     for (int c = 0; c < n && r; ++c) {
@@ -82,7 +83,7 @@ void FrameRecorder::write_units() {
   for (std::size_t i = 0; i < units_.size(); ++i) {
     if (out > 0 && units_[out - 1].frame == units_[i].frame) {
       Unit& m = units_[out - 1];
-      for (int c = 0; c < kMaxCameras; ++c) {
+      for (int c = 0; c < camera_count(); ++c) {
         if (m.slot[c] < 0) {
           m.slot[c] = units_[i].slot[c];
         } else if (units_[i].slot[c] >= 0) {  // the same camera twice: cannot happen

@@ -1,7 +1,7 @@
 // Design: `mocap calibrate-rig [WAND_REC] --wand wand.yaml --out rig.yaml
 // [--intrinsics FILE [--intrinsics FILE]] [--lframe LFRAME_REC] [--report DIR]
 // [--intrinsics-mode auto|refine|fixed] [--min-frames N]`: the wand calibration of
-// src/rigcal (docs/rig_calibration.md) for the 2 to 8 cameras of the recording's
+// src/rigcal (docs/rig_calibration.md) for the 2 to 32 cameras of the recording's
 // rig.yaml. Intrinsics come from the --intrinsics files (rig.yaml, OpenCV FileStorage
 // YAML, ROS camera_info YAML: one file with all cameras or one per camera) or else
 // from the recording's rig.yaml. Without a wand
@@ -210,7 +210,7 @@ void register_calibrate_rig(CLI::App& app, int& exit_code) {
   auto args = std::make_shared<RigArgs>();
   CLI::App* cmd = app.add_subcommand(
       "calibrate-rig",
-      "Calibrate the camera rig (2 to 8 cameras) from a wand recording (and an L-frame), or "
+      "Calibrate the camera rig (2 to 32 cameras) from a wand recording (and an L-frame), or "
       "import intrinsics into rig.yaml");
   cmd->add_option("recording", args->recording, "Wand recording folder");
   cmd->add_option("--wand", args->wand, "Wand (and L-frame) description, wand.yaml");

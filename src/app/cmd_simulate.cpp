@@ -1,14 +1,15 @@
 // Design: `mocap simulate --out DIR [options]`: parses the flags with CLI11 and calls
 // mocap::sim::write_simulated_recording (the library entry point); --scene picks the
 // robot and its marker layout (the shoulder rig's limbs or stalks, or the humanoid),
-// --cameras N renders through the built-in 2..8 cameras, --rig through a
-// user-given rig of 2..8 cameras. Errors are one line
+// --cameras N renders through the built-in 2..8 cameras (the humanoid's ring 2..32), --rig
+// through a user-given rig of 2..32 cameras. Errors are one line
 // on stderr with exit code 2; success prints a one-line summary on stdout.
 #include <cstdio>
 #include <string>
 
 #include "app/command_registry.h"
 #include "app/progress.h"
+#include "sim/scene_cameras.h"
 #include "sim/simulate.h"
 #include "sim/wand_sim.h"
 
@@ -28,7 +29,7 @@ void register_simulate(CLI::App& app, int& exit_code) {
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
       "simulate",
-      "Write a synthetic recording (2..8 cameras) of the shoulder test rig or the humanoid "
+      "Write a synthetic recording (2..32 cameras) of the shoulder test rig or the humanoid "
       "with ground truth");
   cmd->add_option("--out", args->out, "Output folder (created if needed)")->required();
   cmd->add_option("--frames", args->opt.frames, "Number of frames (default 100)");
@@ -37,16 +38,15 @@ void register_simulate(CLI::App& app, int& exit_code) {
                   "limbs) | stalks (its stress variant) | humanoid (the whole-body robot, 15 "
                   "bodies) (default limbs)");
   cmd->add_option("--rig", args->opt.rig_path,
-                  "Render through this rig.yaml (2..8 cameras) instead of the built-in cameras");
+                  "Render through this rig.yaml (2..32 cameras) instead of the built-in cameras");
   cmd->add_option_function<int>(
       "--cameras",
       [args](const int& n) {
         args->opt.cameras = n;
         args->cameras_given = true;
       },
-      "Built-in cameras, 2..8: 2 = the stereo pair, 3..8 on an arc around the "
-      "robot (humanoid: on a ring all around it) (default 2, humanoid 8; with --rig: the "
-      "rig's count)");
+      "Built-in cameras: 2 = the stereo pair, 3..8 on an arc around the robot (humanoid: "
+      "2..32 on a ring all around it) (default 2, humanoid 8; with --rig: the rig's count)");
   cmd->add_option(
       "--motion", args->motion,
       "smooth | poses | move400 | viewpoints | explore | wand | lframe (default smooth)");
@@ -78,8 +78,11 @@ void register_simulate(CLI::App& app, int& exit_code) {
       return;
     }
     args->opt.scene = *scene;
-    if (args->cameras_given && (args->opt.cameras < 2 || args->opt.cameras > 8)) {
-      exit_code = fail("simulate: cameras: must be 2..8, got " + std::to_string(args->opt.cameras));
+    const int max_cameras =
+        *scene == sim::SceneKind::kHumanoid ? sim::kMaxSimCameras : sim::kMaxArcCameras;
+    if (args->cameras_given && (args->opt.cameras < 2 || args->opt.cameras > max_cameras)) {
+      exit_code = fail("simulate: cameras: must be 2.." + std::to_string(max_cameras) +
+                       " for scene " + args->scene + ", got " + std::to_string(args->opt.cameras));
       return;
     }
     if (args->motion == "wand" || args->motion == "lframe") {  // rig calibration recordings

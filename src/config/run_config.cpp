@@ -16,6 +16,7 @@
 #include "formats/rig_yaml.h"
 #include "formats/text_io.h"
 #include "formats/yaml_read.h"
+#include "sim/scene_cameras.h"
 #include "sim/scene_humanoid.h"
 
 namespace mocap::config {
@@ -99,7 +100,10 @@ void read_cameras(const YAML::Node& node, const std::string& dir, RunConfig& cfg
   formats_detail::require_list(node, "cameras");
   const std::size_t n = node.size();
   const std::size_t lo = role == ConfigRole::kNode ? 1 : static_cast<std::size_t>(kMinCameras);
-  const auto hi = static_cast<std::size_t>(kMaxCameras);  // a node: at most 8 as well
+  // A node publishes at most kMaxNodeCameras; the central rig (any backend) up to
+  // kMaxCameras (the pipeline is sized from the count: docs/operations.md).
+  const auto hi =
+      static_cast<std::size_t>(role == ConfigRole::kNode ? kMaxNodeCameras : kMaxCameras);
   if (n < lo || n > hi) {
     fail("cameras", std::to_string(n) + (n == 1 ? " camera, " : " cameras, ") +
                         (n < lo ? "at least " : "at most ") + std::to_string(n < lo ? lo : hi) +
@@ -305,7 +309,9 @@ Expected<RunConfig> parse(const std::string& path, const YAML::Node& root, Confi
   }
   // The simulated camera count: sim.cameras, sim.rig's cameras or the length of the
   // cameras list (any of them, agreeing); kept as cfg.cameras.size() (its one home).
-  std::optional<std::int64_t> sim_cameras = sim.integer("cameras", kMinCameras, kMaxCameras);
+  // The built-in cameras: the humanoid's ring up to kMaxSimCameras, the arc up to 8.
+  std::optional<std::int64_t> sim_cameras = sim.integer(
+      "cameras", kMinCameras, humanoid ? mocap::sim::kMaxSimCameras : mocap::sim::kMaxArcCameras);
   if (humanoid && !sim_cameras && !sim.has("rig") && !top.has("cameras"))
     sim_cameras = mocap::sim::kHumanoidDefaultCameras;  // the humanoid's ring
   if (const auto v = sim.text("rig")) {

@@ -109,10 +109,10 @@ struct OutputSettings {
 
 struct SimSettings {
   int loop_frames = 200;  // frames pre-rendered for the sim backend (humanoid: 100)
-  // The key `sim.cameras` (2..8, sim/scene_cameras.h: the stereo pair, or 3..8 on an arc
-  // around the robot) sets RunConfig::cameras to that many sim cameras: the count's one
-  // home is cameras.size().
-  // The key `sim.rig`: render the simulated cameras through this rig.yaml (2..8 cameras,
+  // The key `sim.cameras` (2..8, the humanoid's ring 2..32; sim/scene_cameras.h: the
+  // stereo pair, or 3..8 on an arc around the robot) sets RunConfig::cameras to that many
+  // sim cameras: the count's one home is cameras.size().
+  // The key `sim.rig`: render the simulated cameras through this rig.yaml (2..32 cameras,
   // any size, e.g. 4 x 1280x1024; its camera count is read at load time, the simulator
   // checks the rest) instead of the built-in ones; the tracker uses it too unless `rig:`
   // is given.

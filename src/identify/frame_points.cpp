@@ -7,6 +7,7 @@
 #include "identify/frame_points.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
 namespace mocap {
@@ -36,7 +37,7 @@ int collect_buckets(const std::array<std::int64_t, 3>& lo, const std::array<std:
 }
 }  // namespace
 
-FramePoints::FramePoints(int max_points)
+FramePoints::FramePoints(int max_points, int cameras)
     : capacity_(max_points),
       bucket_mask_(bucket_count_for(max_points) - 1),
       X_(static_cast<std::size_t>(max_points)),
@@ -49,9 +50,10 @@ FramePoints::FramePoints(int max_points)
       bucket_points_(static_cast<std::size_t>(max_points), 0),
       bucket_of_point_(static_cast<std::size_t>(max_points), 0),
       adj_start_(static_cast<std::size_t>(max_points) + 1, 0),
-      adj_(pairs_.size() * 2, 0) {
-  for (auto& uses : blob_uses_) uses.assign(kBlobSlots, 0);
-}
+      adj_(pairs_.size() * 2, 0),
+      cameras_(std::clamp(cameras, 1, kMaxCameras)),
+      camera_mask_(cameras_ >= 32 ? ~CameraMask{0} : (CameraMask{1} << cameras_) - 1),
+      blob_uses_(static_cast<std::size_t>(cameras_) * kBlobSlots, 0) {}
 
 std::array<std::int64_t, 3> FramePoints::cell_of(const Vec3& x) const noexcept {
   std::array<std::int64_t, 3> c{};
@@ -152,6 +154,9 @@ FramePoints::LoadStats FramePoints::load(const MeasuredPoint* pts, int n,
     const auto s = static_cast<std::size_t>(i);
     X_[s] = pts[i].X_world;
     blob_[s] = pts[i].blob_index;
+    if ((blob_[s].mask() & ~camera_mask_) != 0) {  // a camera the rig does not have
+      for (int c = cameras_; c < kMaxCameras; ++c) blob_[s].clear(static_cast<std::size_t>(c));
+    }
     partial_[s] = pts[i].partial ? 1 : 0;
     valid_[s] = X_[s].allFinite() ? 1 : 0;
     if (!valid_[s]) ++stats.invalid;
@@ -209,10 +214,10 @@ bool FramePoints::exclusive(int i, int j) const noexcept {
 bool FramePoints::available(int i) const noexcept {
   const auto s = static_cast<std::size_t>(i);
   if (!valid_[s] || point_uses_[s] != 0) return false;
-  for (int c = 0; c < kMaxCameras; ++c) {
-    const std::int16_t b = blob_[s][c];
-    if (b >= 0 && blob_uses_[static_cast<std::size_t>(c)][static_cast<std::size_t>(b)] != 0)
-      return false;
+  const BlobRefs& refs = blob_[s];
+  for (CameraMask m = refs.mask(); m != 0; m &= m - 1) {
+    const int c = std::countr_zero(m);
+    if (blob_uses_[use_slot(c, refs[c])] != 0) return false;
   }
   return true;
 }
@@ -220,32 +225,24 @@ bool FramePoints::available(int i) const noexcept {
 int FramePoints::uses(int i) const noexcept {
   const auto s = static_cast<std::size_t>(i);
   int u = point_uses_[s];
-  for (int c = 0; c < kMaxCameras; ++c) {
-    const std::int16_t b = blob_[s][c];
-    if (b >= 0)
-      u = std::max<int>(u, blob_uses_[static_cast<std::size_t>(c)][static_cast<std::size_t>(b)]);
-  }
+  blob_[s].for_each([&](int c, int b) { u = std::max<int>(u, blob_uses_[use_slot(c, b)]); });
   return u;
 }
 
 void FramePoints::acquire(int i) noexcept {
   const auto s = static_cast<std::size_t>(i);
   ++point_uses_[s];
-  for (int c = 0; c < kMaxCameras; ++c) {
-    const std::int16_t b = blob_[s][c];
-    if (b >= 0) ++blob_uses_[static_cast<std::size_t>(c)][static_cast<std::size_t>(b)];
-  }
+  blob_[s].for_each([&](int c, int b) { ++blob_uses_[use_slot(c, b)]; });
 }
 
 void FramePoints::release(int i) noexcept {
   const auto s = static_cast<std::size_t>(i);
   if (point_uses_[s] == 0) return;
   --point_uses_[s];
-  for (int c = 0; c < kMaxCameras; ++c) {
-    const std::int16_t b = blob_[s][c];
-    if (b >= 0 && blob_uses_[static_cast<std::size_t>(c)][static_cast<std::size_t>(b)] > 0)
-      --blob_uses_[static_cast<std::size_t>(c)][static_cast<std::size_t>(b)];
-  }
+  blob_[s].for_each([&](int c, int b) {
+    std::uint16_t& u = blob_uses_[use_slot(c, b)];
+    if (u > 0) --u;
+  });
 }
 
 void FramePoints::release_all() noexcept {

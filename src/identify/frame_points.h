@@ -30,7 +30,9 @@ struct PointPair {
 
 class FramePoints {
  public:
-  explicit FramePoints(int max_points);
+  // `cameras`: the rig's camera count (1..kMaxCameras); the blob occupancy is sized by it
+  // and a point's views of cameras at or above it are ignored.
+  explicit FramePoints(int max_points, int cameras = kMaxCameras);
 
   struct LoadStats {
     int dropped = 0;  // beyond capacity
@@ -75,6 +77,9 @@ class FramePoints {
   std::uint32_t bucket_of(const std::array<std::int64_t, 3>& cell) const noexcept;
   void build_grid() noexcept;
   void build_pairs(double max2) noexcept;
+  static std::size_t use_slot(int camera, int blob) noexcept {
+    return static_cast<std::size_t>(camera) * kBlobSlots + static_cast<std::size_t>(blob);
+  }
 
   int capacity_;
   int n_ = 0;
@@ -88,13 +93,15 @@ class FramePoints {
   std::vector<std::uint8_t> valid_;
   std::vector<std::uint8_t> partial_;
   std::vector<std::uint16_t> point_uses_;
-  std::array<std::vector<std::uint16_t>, kMaxCameras> blob_uses_;  // per camera, per blob
   std::vector<PointPair> pairs_;
   std::vector<std::int32_t> bucket_start_;  // counting sort of the points by bucket
   std::vector<std::int16_t> bucket_points_;
   std::vector<std::uint32_t> bucket_of_point_;
   std::vector<std::int32_t> adj_start_;  // CSR neighbour lists
   std::vector<std::int16_t> adj_;
+  int cameras_;
+  CameraMask camera_mask_;                // the cameras 0..cameras_-1
+  std::vector<std::uint16_t> blob_uses_;  // camera c, blob b at c * kBlobSlots + b
 };
 
 }  // namespace mocap

@@ -43,7 +43,7 @@ Identifier::Identifier(const IdentifyConfig& config, std::vector<TargetModel> mo
     : config_(config),
       models_(std::move(models)),
       motion_(config),
-      frame_(config.max_points),
+      frame_(config.max_points, config.cameras),
       search_(config, marker_diameter_mm),
       gate_(config),
       tracks_(models_.size()),

@@ -44,7 +44,10 @@ struct IdentifyConfig {
   // |r|, so that a small subset cannot win merely because a 3-point fit absorbs 6 of its 9
   // noise degrees of freedom (0 gives the paper's literal score; see identification.md).
   double residual_floor_mm = 0.5;
-  int max_points = kMaxPoints;   // per-frame capacity (<= kMaxPoints); extra points dropped
+  int max_points = kMaxPoints;  // per-frame capacity (<= kMaxPoints); extra points dropped
+  // Cameras of the rig (1..kMaxCameras; FrameProcessor sets the rig's): sizes the
+  // per-camera blob occupancy. Views of cameras at or above it are ignored.
+  int cameras = kMaxCameras;
   int max_search_nodes = 20000;  // per target and frame; hitting it is counted
   // A solution is accepted only if every solution that contradicts it (a point on another
   // marker, a marker on another point) scores at least ambiguity_ratio times worse;

@@ -36,6 +36,10 @@ Expected<void> validate_config(const IdentifyConfig& c) {
     return make_error(
         f, "max_points",
         "must be in [3, " + std::to_string(kMaxPoints) + "], got " + std::to_string(c.max_points));
+  if (c.cameras < 1 || c.cameras > kMaxCameras)
+    return make_error(
+        f, "cameras",
+        "must be in [1, " + std::to_string(kMaxCameras) + "], got " + std::to_string(c.cameras));
   if (!(c.point_sigma_mm >= 0.0) || !std::isfinite(c.point_sigma_mm))
     return make_error(f, "point_sigma_mm", "must be >= 0, got " + num(c.point_sigma_mm));
   if (!std::isfinite(c.partial_sigma_mm) ||

@@ -1,4 +1,4 @@
-// Design: bundle adjustment of a rig of 2..8 cameras from wand observations (Ceres), one
+// Design: bundle adjustment of a rig of 2..32 cameras from wand observations (Ceres), one
 // joint problem over all cameras. The world is camera 0's frame (its pose is held
 // constant: the gauge); every other camera's pose is an angle-axis rotation plus a
 // translation. Each wand frame is the position A of marker 0

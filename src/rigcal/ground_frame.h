@@ -1,5 +1,5 @@
 // Design: the ground (world) frame from an L-frame recording. With the calibrated rig
-// (2..8 cameras), every frame's blobs are matched across each pair of cameras by the
+// (2..32 cameras), every frame's blobs are matched across each pair of cameras by the
 // epipolar constraint and triangulated (optimal two-view triangulation,
 // stereo/two_view.h); the L-frame is static, so the 3D points of all pairs are
 // clustered over the frames (a marker seen by k cameras adds up to k(k-1)/2 points per

@@ -1,4 +1,4 @@
-// Design: the initial rig of 2..8 cameras for the bundle adjustment, built pairwise.
+// Design: the initial rig of 2..32 cameras for the bundle adjustment, built pairwise.
 // Camera 0 is the world. Each other camera is initialised from a reference camera
 // whose pose is already known: camera 0 when the two share at least min_shared_frames
 // frames with the wand labelled in both, otherwise the initialised camera it shares the

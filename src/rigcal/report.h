@@ -1,6 +1,6 @@
 // Design: the calibration quality report: report.yaml (every number of RigCalResult
 // that a user or a script checks: reprojection RMS per camera, wand-length error,
-// coverage, frames, warnings; per camera of a 2..8-camera rig also its frames used and
+// coverage, frames, warnings; per camera of a 2..32-camera rig also its frames used and
 // its pose relative to camera 0) and one coverage PNG per camera (half resolution: the
 // coverage grid, occupied cells tinted green, each labelled wand marker a white dot).
 #pragma once

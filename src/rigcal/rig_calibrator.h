@@ -1,4 +1,4 @@
-// Design: the wand calibration of a rig of 2..8 cameras (kMinRigCameras..kMaxRigCameras),
+// Design: the wand calibration of a rig of 2..32 cameras (kMinRigCameras..kMaxRigCameras),
 // end to end (`mocap calibrate-rig`):
 //  1. detect blobs in every frame of the wand recording (BlobDetector; merged, split
 //     and border blobs are dropped, and less round ones unless they are wand balls
@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "camera/camera_model.h"
+#include "core/camera_set.h"
 #include "core/expected.h"
 #include "detect/detector_config.h"
 #include "formats/wand_yaml.h"
@@ -38,7 +39,7 @@
 namespace mocap::rigcal {
 
 inline constexpr std::size_t kMinRigCameras = 2;
-inline constexpr std::size_t kMaxRigCameras = 8;
+inline constexpr std::size_t kMaxRigCameras = kMaxCameras;  // the rig's bound
 
 enum class IntrinsicsMode { kAuto, kRefine, kFixed };
 
@@ -120,7 +121,7 @@ struct DetectedRecording {
 // recorder's detector found them (its settings, not options.detector), without edge fits
 // (they need the images): the centres are the centroids, partly hidden balls are left
 // out, and a note says so.
-// Detects blobs in every frame of a recording (every camera of its rig.yaml: 2..8, else
+// Detects blobs in every frame of a recording (every camera of its rig.yaml: 2..32, else
 // a one-line error naming the rig.yaml). Blobs that are merged, split or touch the
 // border are left out. A blob less round than options.min_roundness x the roundness a
 // whole ball has at that place in the image (a ball's image is an ellipse stretched
@@ -149,7 +150,7 @@ double expected_roundness(const CameraModel& cam, const Vec2& px) noexcept;
 double expected_radial_stretch(const CameraModel& cam, const Vec2& px) noexcept;
 
 // The calibration from already detected blobs. intrinsics: the cameras' intrinsics
-// (2..8; names and sizes must be set; extrinsics ignored), blobs with one entry per
+// (2..32; names and sizes must be set; extrinsics ignored), blobs with one entry per
 // camera. info (optional, the shape of blobs): the centres' covariances, which weigh the
 // bundle adjustment's residuals (BundleOptions::weight_by_covariance), and which are
 // partly hidden (left out of the wand-length figure). source names the

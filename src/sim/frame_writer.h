@@ -1,7 +1,7 @@
 // Design: the rendering and frame-writing set-up shared by the recording writers
 // (simulate.cpp: `mocap simulate`, wand_sim.cpp: wand/L-frame recordings) and the
 // simulated camera's pre-rendered loop (hal/sim_camera.cpp):
-//   MultiRender          : renders a scene state in every camera of the rig (2..8) with
+//   MultiRender          : renders a scene state in every camera of the rig (2..32) with
 //                          one RenderWorkspace per rendering thread (the second copied
 //                          from the first, sharing nothing mutable): with threads >= 2
 //                          the even cameras on the calling thread, the odd ones on a

@@ -62,11 +62,13 @@ Expected<void> check_scene_options(const SceneOptions& options) {
     return make_error("simulate", "dropout", "probability must be in [0, 1]");
   if (options.stray_glints < 0 || options.stray_glints > 64)
     return make_error("simulate", "stray", "must be 0..64");
+  // Built-in cameras: the humanoid's ring takes up to kMaxSimCameras, the arc up to 8.
+  const int max_built_in = options.kind == SceneKind::kHumanoid ? kMaxSimCameras : kMaxArcCameras;
   if (!options.rig && options.cameras != 0 &&
-      (options.cameras < kMinSimCameras || options.cameras > kMaxSimCameras)) {
+      (options.cameras < kMinSimCameras || options.cameras > max_built_in)) {
     return make_error("simulate", "cameras",
                       "must be " + std::to_string(kMinSimCameras) + ".." +
-                          std::to_string(kMaxSimCameras) + ", got " +
+                          std::to_string(max_built_in) + " for this scene, got " +
                           std::to_string(options.cameras));
   }
   return {};

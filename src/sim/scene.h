@@ -1,7 +1,7 @@
 // Design: the simulator's built-in robots. Every scene is a kinematic tree of rigid
 // bodies, each a set of capsules (limbs and the posts that hold the marker balls)
 // carrying a marker target, joined by ball and hinge joints (SimJoint, in topological
-// order from the root body), seen by built-in cameras or by a user-given rig of 2..8
+// order from the root body), seen by built-in cameras or by a user-given rig of 2..32
 // cameras (scene_rig.h). Two robots:
 //  - the paper's shoulder test rig (build_shoulder_scene): three bodies (torso,
 //    upper_arm, lower_arm), a ball joint (shoulder) and a hinge (elbow), seen by a
@@ -9,7 +9,7 @@
 //    (scene_cameras.h); two marker layouts (scene_layouts.h): `limbs` (default, markers
 //    all around each limb on short bases) and `stalks` (the stress variant);
 //  - a whole-body humanoid (scene_humanoid.h, `--scene humanoid`): 15 bodies, 14 joints,
-//    71 markers, on a ring of 2..8 cameras around it.
+//    71 markers, on a ring of 2..32 cameras around it.
 // SimScene is immutable after build_scene(); a SceneState (body poses + noise key) is
 // what changes per frame. apply_config() is the forward kinematics: allocation-free,
 // noexcept. A JointConfig commands each joint in its own command axes (SimJoint::
@@ -101,7 +101,8 @@ ImagingParams default_imaging(int bits, int maxval);
 struct SceneOptions {
   SceneKind kind = SceneKind::kLimbs;  // the robot and its marker layout
   std::optional<Rig> rig;              // user-given cameras (checked); none: the built-in ones
-  int cameras = 0;         // built-in cameras (2..8; 0: the scene's default; ignored with a rig)
+  int cameras =
+      0;  // built-in cameras (2..8, humanoid 2..32; 0: the scene's default; ignored with a rig)
   std::string rig_source;  // names the user rig in errors (its file)
   std::uint64_t seed = 1;
   int stray_glints = 0;  // number of shiny spots on the limbs

@@ -13,7 +13,7 @@
 namespace mocap::sim {
 
 // Checks shared by every scene: the imaging parameters, the glint count and, without a
-// user rig, the built-in camera count (2..8).
+// user rig, the built-in camera count (2..8, the humanoid 2..32).
 Expected<void> check_scene_options(const SceneOptions& options);
 
 // A limb capsule of body b given in the world at the reference configuration.

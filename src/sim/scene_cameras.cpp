@@ -22,7 +22,7 @@ struct Lens {
 };
 
 // Slots 0 and 1 are the pair's lenses; the others spread like the pair's two units do.
-constexpr std::array<Lens, kMaxSimCameras> kRingLenses = {{
+constexpr std::array<Lens, kMaxArcCameras> kRingLenses = {{
     {1291.2, 1290.6, 517.3, 385.9, {-0.121, 0.083, 0.0004, -0.0003, 0.0}, 0.3},
     {1288.7, 1288.1, 513.8, 389.4, {-0.118, 0.079, -0.0002, 0.0005, 0.0}, -0.4},
     {1293.4, 1292.9, 519.6, 384.2, {-0.124, 0.087, 0.0003, 0.0002, 0.0}, 0.5},
@@ -77,7 +77,7 @@ RingSlot ring_slot(int k, int n) noexcept {
 
 std::vector<CameraModel> built_in_cameras(SceneKind kind, const Vec3& robot_center_world, int n) {
   std::vector<CameraModel> cams;
-  if (n < kMinSimCameras || n > kMaxSimCameras) return cams;
+  if (n < kMinSimCameras || n > kMaxArcCameras) return cams;
   if (n == 2) {  // the verged pair: x = mount.x -+ 238.5, aimed at (mount.x, 250, aim_z)
     const CameraMount mount = camera_mount(kind);
     const Vec3 aim(mount.x_mm, 250.0, mount.aim_z_mm);  // where the optical axes cross

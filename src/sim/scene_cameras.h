@@ -1,4 +1,5 @@
-// Design: the built-in cameras of the simulator, 2 to 8 (`mocap simulate --cameras N`).
+// Design: the built-in cameras of the simulator's shoulder rig, 2 to 8 (`mocap simulate
+// --cameras N`; the humanoid's ring of up to 32 is in scene_humanoid.h).
 //  - N = 2: the verged stereo pair of the scene (scene_layouts.h, CameraMount), exactly
 //    as it always was (rig.yaml byte for byte).
 //  - N = 3..8: the cameras stand on an arc around the robot, as a lab rigs a capture
@@ -23,13 +24,17 @@
 #include <vector>
 
 #include "camera/camera_model.h"
+#include "core/camera_set.h"
 #include "core/types.h"
 #include "sim/scene_layouts.h"
 
 namespace mocap::sim {
 
 inline constexpr int kMinSimCameras = 2;
-inline constexpr int kMaxSimCameras = 8;
+// The limbs/stalks scenes' built-in cameras: the pair or an arc of up to 8.
+inline constexpr int kMaxArcCameras = 8;
+// Cameras the simulator renders: the humanoid's ring and a user rig, up to the rig bound.
+inline constexpr int kMaxSimCameras = kMaxCameras;
 
 // Where camera k of n (n >= 3) stands, relative to the robot centre.
 struct RingSlot {
@@ -40,8 +45,8 @@ struct RingSlot {
 
 RingSlot ring_slot(int k, int n) noexcept;
 
-// The built-in cameras cam0..cam<n-1> for n in 2..8 (n outside: empty). robot_center_world
-// is where the ring cameras stand around and aim at (unused for n = 2).
+// The built-in cameras cam0..cam<n-1> for n in 2..kMaxArcCameras (n outside: empty).
+// robot_center_world is where the ring cameras stand around and aim at (unused for n = 2).
 std::vector<CameraModel> built_in_cameras(SceneKind kind, const Vec3& robot_center_world, int n);
 
 }  // namespace mocap::sim

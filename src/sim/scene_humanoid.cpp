@@ -206,15 +206,16 @@ std::vector<CameraModel> humanoid_cameras(const Vec3& center_world, int n) {
   if (n < kMinSimCameras || n > kMaxSimCameras) return cams;
   // 1280 x 1024 sensors behind ~6.7 mm lenses (fx ~1400 px at 4.8 um): the unit-to-unit
   // spread of the shoulder ring's lenses (built_in_cameras), re-centred.
+  // A ring of more than 8 repeats the 8 lenses (camera k has lens k % 8).
   const std::vector<CameraModel> spread =
-      built_in_cameras(SceneKind::kLimbs, Vec3::Zero(), kMaxSimCameras);
+      built_in_cameras(SceneKind::kLimbs, Vec3::Zero(), kMaxArcCameras);
   for (int k = 0; k < n; ++k) {
     const double az_deg = n == 2 ? (k == 0 ? -25.0 : 25.0) : 22.5 + 360.0 * k / n;
     const double z = n == 2 ? 1900.0 : (k % 2 == 0 ? 2300.0 : 1500.0);
     const double a = az_deg * kRadPerDeg;
     const Vec3 centre(center_world.x() + 3000.0 * std::sin(a),
                       center_world.y() - 3000.0 * std::cos(a), z);
-    const CameraModel& lens = spread[static_cast<std::size_t>(k)];
+    const CameraModel& lens = spread[static_cast<std::size_t>(k % kMaxArcCameras)];
     CameraModel cam;
     cam.name = "cam" + std::to_string(k);
     cam.width = 1280;

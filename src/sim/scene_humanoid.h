@@ -14,7 +14,7 @@
 // of another target within 2.5 mm (no copies; left and right are not mirror images).
 // Triangles of different limbs may still fit within the identifier's t, as on a real
 // robot: the tracker resolves those by continuity and the other markers.
-// Cameras: a ring of N = 2..8 (default 8) 1280 x 1024 cameras around the robot, 3 m
+// Cameras: a ring of N = 2..32 (default 8) 1280 x 1024 cameras around the robot, 3 m
 // from the vertical through it, alternately 2.3 m and 1.5 m above the floor, every one
 // aimed at the robot's centre; N = 2 is a pair in front of it. Motions (motion.h):
 // smooth (every joint and the root), poses (static calibration poses) and explore
@@ -38,7 +38,7 @@ inline constexpr int kHumanoidDefaultCameras = 8;
 
 Expected<SimScene> build_humanoid_scene(const SceneOptions& options);
 
-// The built-in ring of n (2..8) cameras around a robot centred at center_world (n
+// The built-in ring of n (2..32) cameras around a robot centred at center_world (n
 // outside: empty).
 std::vector<CameraModel> humanoid_cameras(const Vec3& center_world, int n);
 

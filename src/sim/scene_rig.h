@@ -5,7 +5,8 @@
 // the image physics stay the same. Before anything is rendered, the rig is checked
 // against the scene, each problem one line naming the rig file and the camera (the
 // built-in cameras for --cameras 3..8 go through the same check):
-//  - 2 to 8 cameras (the spec's extension of 2026-12), with distinct names that can be
+//  - 2 to 32 cameras (the spec's extension of 2026-12: 2 to 8; 2027-01: 32), with distinct names
+//  that can be
 //    recording folders (not empty, not 'gt', no '/');
 //  - a physical lens over the whole image: every image corner undistorts, and the
 //    radial mapping r -> r * (1 + k1 r^2 + k2 r^4 + k3 r^6) keeps increasing out to the

@@ -1,5 +1,5 @@
 // Design: the recording writer. Per frame: forward kinematics, one render per camera
-// (MultiRender, frame_writer.h: 2..8 cameras, the odd ones on a second thread with its
+// (MultiRender, frame_writer.h: 2..32 cameras, the odd ones on a second thread with its
 // own workspace when threads = 2; results are identical either way because every
 // random draw is keyed by seed, frame and camera), the PGM files, then the
 // ground-truth rows (per-camera columns for every camera). Files are written with

@@ -1,5 +1,5 @@
 // Design: the library entry point of `mocap simulate`: builds the scene from
-// SimOptions, plans the motion, renders every frame of every camera (2..8) and writes
+// SimOptions, plans the motion, renders every frame of every camera (2..32) and writes
 // the recording folder (spec: rig.yaml, frames.csv, cam0/, cam1/, ...), targets.yaml,
 // joints.yaml and the ground truth under gt/ (poses.csv, angles.csv, markers.csv,
 // strays.csv, segments.csv, model_true.yaml); see docs/simulator.md for every file
@@ -19,8 +19,8 @@ namespace mocap::sim {
 
 struct SimOptions {
   SceneKind scene = SceneKind::kLimbs;  // the robot and its layout (scene_layouts.h)
-  std::string rig_path;                 // user rig (rig.yaml, 2..8 cameras) instead of the built-in
-  int cameras = 0;  // built-in cameras 2..8 (0: the scene's default: the pair, the humanoid's 8)
+  std::string rig_path;  // user rig (rig.yaml, 2..32 cameras) instead of the built-in
+  int cameras = 0;  // built-in cameras 2..8, humanoid 2..32 (0: the scene's default: the pair, 8)
                     // with rig_path: 0 or its count
   int frames = 100;
   MotionKind motion = MotionKind::kSmooth;

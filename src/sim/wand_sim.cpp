@@ -2,7 +2,7 @@
 // wand_sim.h). The scene reuses the shoulder scenario's rig and imaging (make_scene)
 // so the calibration recordings are seen by exactly the rig the other recordings use.
 // Bodies: 0 = the calibration object, 1 = the room (static glints only).
-// The folder set-up and the render of every camera (2..8) + PGM writing are
+// The folder set-up and the render of every camera (2..32) + PGM writing are
 // frame_writer.h's.
 #include "sim/wand_sim.h"
 

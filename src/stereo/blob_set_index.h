@@ -10,6 +10,7 @@
 #pragma once
 
 #include <algorithm>
+#include <bit>
 #include <cstdint>
 #include <cstring>
 #include <vector>
@@ -75,11 +76,18 @@ class BlobSetIndex {
 
   BlobSetIndex() = default;
 
+  // Cameras 0..7 as two words (an 8-camera rig hashes what it always did); a camera
+  // above 7 folds its entry in (bits of the mask above 7).
   static std::size_t hash(const BlobRefs& key) noexcept {
-    static_assert(sizeof(BlobRefs) == 16, "BlobRefs: 8 x int16");
+    static_assert(sizeof(BlobRefs::Array) >= 16, "BlobRefs: at least 8 x int16");
     std::uint64_t w[2];
-    std::memcpy(w, &key, sizeof(w));
+    std::memcpy(w, key.indices().data(), sizeof(w));
     std::uint64_t h = w[0] * 0x9E3779B97F4A7C15ull ^ (w[1] + 0x632BE59BD9B4E019ull);
+    for (CameraMask m = key.mask() >> 8; m != 0; m &= m - 1) {
+      const int c = 8 + std::countr_zero(m);
+      h = (h ^ static_cast<std::uint64_t>(static_cast<std::uint16_t>(key[c])) << (c % 48)) *
+          0x9E3779B97F4A7C15ull;
+    }
     h ^= h >> 31;
     h *= 0xD6E8FEB86659FD93ull;
     h ^= h >> 32;

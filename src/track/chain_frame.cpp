@@ -3,8 +3,9 @@
 // joint's solved-by flag and standard deviations.
 #include <Eigen/Eigenvalues>
 #include <algorithm>
-#include <bitset>
+#include <bit>
 #include <cmath>
+#include <cstring>
 #include <numbers>
 
 #include "core/rotation.h"
@@ -15,6 +16,7 @@ namespace mocap {
 namespace {
 
 constexpr std::size_t kBlobBits = 4096;  // blobs beyond this index are not ghost-checked
+constexpr std::size_t kBlobWords = kBlobBits / 64;
 
 Mat3 exp_hinge(const Vec3& axis, double a) noexcept {
   return Eigen::AngleAxisd(a, axis).toRotationMatrix();
@@ -68,14 +70,19 @@ void ChainSolver::solve(const MeasuredPoint* pts, int n, std::int64_t t_ns, cons
 
   if (config_.enabled && nj > 0) {
     // 1. Points of found bodies, and their epipolar ghosts, are not available.
-    std::array<std::bitset<kBlobBits>, kMaxCameras> used_blob;
+    // One row of kBlobBits bits per camera, up to the highest camera a point uses (only
+    // those rows are cleared: an 8-camera rig clears what it did with 8 possible cameras).
+    CameraMask seen = 0;
+    for (int p = 0; p < n; ++p) seen |= pts[p].blob_index.mask();
+    std::uint64_t used_blob[kMaxCameras][kBlobWords];
+    std::memset(used_blob, 0,
+                sizeof(used_blob[0]) * static_cast<std::size_t>(std::bit_width(seen)));
     const auto take = [&](int p) {
       available_[static_cast<std::size_t>(p)] = false;
-      for (std::size_t c = 0; c < used_blob.size(); ++c) {
-        const int bi = pts[p].blob_index[c];
-        if (bi >= 0 && static_cast<std::size_t>(bi) < kBlobBits)
-          used_blob[c].set(static_cast<std::size_t>(bi));
-      }
+      pts[p].blob_index.for_each([&](int c, int bi) {
+        if (static_cast<std::size_t>(bi) < kBlobBits)
+          used_blob[c][bi >> 6] |= std::uint64_t{1} << (bi & 63);
+      });
     };
     for (int p = 0; p < n; ++p)
       available_[static_cast<std::size_t>(p)] = pts[p].X_world.allFinite();
@@ -86,12 +93,11 @@ void ChainSolver::solve(const MeasuredPoint* pts, int n, std::int64_t t_ns, cons
     }
     const auto ghost_check = [&]() {
       for (int p = 0; p < n; ++p) {
-        for (std::size_t c = 0; c < used_blob.size(); ++c) {
-          const int bi = pts[p].blob_index[c];
-          if (bi >= 0 && static_cast<std::size_t>(bi) < kBlobBits &&
-              used_blob[c].test(static_cast<std::size_t>(bi)))
+        pts[p].blob_index.for_each([&](int c, int bi) {
+          if (static_cast<std::size_t>(bi) < kBlobBits &&
+              ((used_blob[c][bi >> 6] >> (bi & 63)) & 1u) != 0)
             available_[static_cast<std::size_t>(p)] = false;
-        }
+        });
       }
     };
     ghost_check();

@@ -2,6 +2,7 @@
 #include "track/frame_processor.h"
 
 #include <algorithm>
+#include <bit>
 #include <utility>
 
 #include "core/clock.h"
@@ -37,7 +38,9 @@ Expected<FrameProcessor> FrameProcessor::create(const Rig& rig, const TargetSet&
   if (targets.marker_diameter_mm > 0.0) mvc.marker_radius_mm = 0.5 * targets.marker_diameter_mm;
   auto merger = MultiViewMerger::create(rig, mvc);
   if (!merger) return Error{"multi-view: " + merger.error().message};
-  auto ident = Identifier::create(targets, config.identify);
+  IdentifyConfig id_config = config.identify;
+  id_config.cameras = n_cams;  // the blob occupancy of the rig's cameras only
+  auto ident = Identifier::create(targets, id_config);
   if (!ident) return Error{"identification: " + ident.error().message};
 
   std::optional<kinematics::JointAngleSolver> angles;
@@ -55,8 +58,8 @@ Expected<FrameProcessor> FrameProcessor::create(const Rig& rig, const TargetSet&
     if (!shape) return shape.error();
     p.shapes_.push_back(std::move(shape).value());
   }
-  auto selector = PointSelector::create(config.stereo.max_candidates,
-                                        config.stereo.max_points_per_camera, config.selection);
+  auto selector = PointSelector::create(
+      config.stereo.max_candidates, config.stereo.max_points_per_camera, config.selection, n_cams);
   if (!selector) return selector.error();
   p.selector_ = std::move(selector).value();
   if (model != nullptr) {
@@ -213,9 +216,9 @@ void FrameProcessor::measure_points(FrameOutput& out) noexcept {
     // Which views look like a whole marker at the point's position.
     BlobRefs whole = p.blob_index;
     int n_whole = 0;
-    for (int c = 0; c < camera_count(); ++c) {
+    for (CameraMask seen = p.blob_index.mask(); seen != 0; seen &= seen - 1) {
+      const int c = std::countr_zero(seen);
       const int b = p.blob_index[c];
-      if (b < 0) continue;
       if (whole_marker_view(c, out.blobs[static_cast<std::size_t>(c)], b, p.X_world))
         ++n_whole;
       else
@@ -243,9 +246,10 @@ void FrameProcessor::measure_points(FrameOutput& out) noexcept {
     double sigma = 0.0;
     if (partial) {
       double shift = 0.0;
-      for (int c = 0; c < camera_count(); ++c) {
+      for (CameraMask seen = p.blob_index.mask(); seen != 0; seen &= seen - 1) {
+        const int c = std::countr_zero(seen);
         const int b = p.blob_index[c];
-        if (b < 0 || whole[c] >= 0) continue;
+        if (whole[c] >= 0) continue;
         const detect::BlobList& blobs = out.blobs[static_cast<std::size_t>(c)];
         const double f = static_cast<std::size_t>(b) < blobs.size()
                              ? shapes_[static_cast<std::size_t>(c)].visible_fraction(
@@ -256,8 +260,9 @@ void FrameProcessor::measure_points(FrameOutput& out) noexcept {
         const Vec3 ray =
             (p.X_world - rig_.cameras[static_cast<std::size_t>(c)].center_world()).normalized();
         double sin_best = 0.0;
-        for (int o = 0; o < camera_count(); ++o) {
-          if (o == c || p.blob_index[o] < 0) continue;
+        for (CameraMask others = p.blob_index.mask() & ~(CameraMask{1} << c); others != 0;
+             others &= others - 1) {
+          const int o = std::countr_zero(others);
           const Vec3 other =
               (p.X_world - rig_.cameras[static_cast<std::size_t>(o)].center_world()).normalized();
           sin_best = std::max(sin_best, ray.cross(other).norm());

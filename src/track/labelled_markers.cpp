@@ -24,10 +24,7 @@ int label_markers(const FrameOutput& out, const TargetSet& targets,
       l.body = static_cast<std::int16_t>(b);
       l.marker = static_cast<std::int16_t>(m);
       l.point = p;
-      l.cameras = 0;
-      for (std::size_t c = 0; c < point.blob_index.size() && c < 8; ++c) {
-        if (point.blob_index[c] >= 0) l.cameras = static_cast<std::uint8_t>(l.cameras | (1u << c));
-      }
+      l.cameras = point.blob_index.mask();
       l.X_world_mm = point.X_world;
       l.residual_mm =
           (point.X_world - pose.T_world_body * model[static_cast<std::size_t>(m)]).norm();

@@ -26,7 +26,7 @@ struct LabelledMarker {
   std::int16_t body = 0;           // index in targets.yaml
   std::int16_t marker = 0;         // index in that body's target (targets.yaml order)
   std::int16_t point = -1;         // index in FrameOutput::points
-  std::uint8_t cameras = 0;        // bit c set: camera c saw the point (c < 8)
+  CameraMask cameras = 0;          // bit c set: camera c saw the point
   Vec3 X_world_mm = Vec3::Zero();  // the measured point, world frame
   double residual_mm = 0.0;        // |X_world_mm - T_world_body * model marker|
 };

@@ -2,16 +2,19 @@
 #include "track/point_selection.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <string>
 
 namespace mocap {
 
 Expected<PointSelector> PointSelector::create(int max_candidates, int max_blobs_per_camera,
-                                              const PointSelectionConfig& c) {
+                                              const PointSelectionConfig& c, int cameras) {
   if (max_candidates < 1) return make_error("stereo", "max_candidates", "must be >= 1");
   if (max_blobs_per_camera < 1)
     return make_error("stereo", "max_points_per_camera", "must be >= 1");
+  if (cameras < 1 || cameras > kMaxCameras)
+    return make_error("rig", "cameras", "must be 1.." + std::to_string(kMaxCameras));
   if (!(std::isfinite(c.max_speed_mm_per_s) && c.max_speed_mm_per_s >= 0.0))
     return make_error("selection", "max_speed_mm_per_s", "must be a non-negative number");
   if (!(std::isfinite(c.point_sigma_mm) && c.point_sigma_mm > 0.0))
@@ -21,27 +24,30 @@ Expected<PointSelector> PointSelector::create(int max_candidates, int max_blobs_
   PointSelector s;
   s.config_ = c;
   s.max_blobs_ = max_blobs_per_camera;
-  s.taken_.assign(static_cast<std::size_t>(kMaxCameras * max_blobs_per_camera), 0);
+  s.cameras_ = cameras;
+  s.taken_.assign(
+      static_cast<std::size_t>(cameras) * static_cast<std::size_t>(max_blobs_per_camera), 0);
   s.keys_.resize(static_cast<std::size_t>(max_candidates));
   s.prev_.resize(static_cast<std::size_t>(max_candidates));
   return s;
 }
 
 bool PointSelector::free_blobs(const Point3& p) const noexcept {
-  for (int c = 0; c < kMaxCameras; ++c) {
-    const int b = p.blob_index[static_cast<std::size_t>(c)];
-    if (b < 0) continue;
-    if (b >= max_blobs_ || taken_[static_cast<std::size_t>(c * max_blobs_ + b)] != 0) return false;
+  for (CameraMask m = p.blob_index.mask(); m != 0; m &= m - 1) {
+    const int c = std::countr_zero(m);
+    const int b = p.blob_index[c];
+    if (c >= cameras_ || b >= max_blobs_ ||
+        taken_[static_cast<std::size_t>(c * max_blobs_ + b)] != 0)
+      return false;
   }
   return true;
 }
 
 void PointSelector::take(Point3& p) noexcept {
   p.reported = true;
-  for (int c = 0; c < kMaxCameras; ++c) {
-    const int b = p.blob_index[static_cast<std::size_t>(c)];
-    if (b >= 0 && b < max_blobs_) taken_[static_cast<std::size_t>(c * max_blobs_ + b)] = 1;
-  }
+  p.blob_index.for_each([&](int c, int b) {
+    if (c < cameras_ && b < max_blobs_) taken_[static_cast<std::size_t>(c * max_blobs_ + b)] = 1;
+  });
 }
 
 PointSelectionStats PointSelector::select(const BodyPoses& poses, std::int64_t timestamp_ns,

@@ -43,8 +43,11 @@ struct PointSelectionStats {
 class PointSelector {
  public:
   PointSelector() = default;
+  // `cameras`: the rig's camera count (1..kMaxCameras), which sizes the blob table; a
+  // view of a camera at or above it counts as a blob beyond max_blobs_per_camera.
   static Expected<PointSelector> create(int max_candidates, int max_blobs_per_camera,
-                                        const PointSelectionConfig& config);
+                                        const PointSelectionConfig& config,
+                                        int cameras = kMaxCameras);
 
   // Sets Point3::reported on every candidate of `points`. `poses` are this frame's
   // identification results (their point indices refer to `points`).
@@ -62,7 +65,8 @@ class PointSelector {
 
   PointSelectionConfig config_;
   int max_blobs_ = 0;
-  std::vector<std::uint8_t> taken_;  // kMaxCameras x max_blobs_
+  int cameras_ = 0;
+  std::vector<std::uint8_t> taken_;  // cameras_ x max_blobs_
   std::vector<Key> keys_;
   std::vector<Vec3> prev_;
   int prev_count_ = 0;

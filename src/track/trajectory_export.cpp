@@ -95,7 +95,7 @@ bool LabelledExports::write_frame(std::size_t index, const LabelledMarkers& labe
     if (t >= samples_.size()) continue;
     TrajectorySample& s = samples_[t];
     s.valid = true;
-    s.cameras = l.cameras;
+    s.cameras = static_cast<std::uint8_t>(l.cameras & 0x7Fu);  // C3D: cameras 0..6 only
     s.X_mm = l.X_world_mm;
     s.residual_mm = l.residual_mm;
   }

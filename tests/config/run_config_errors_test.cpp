@@ -61,13 +61,20 @@ const ErrorCase kCases[] = {
     {"CamerasNotAList", "cameras: {backend: sim}\n",
      "cameras: expected a list, got a map (line 1)"},
     {"OneCamera", "cameras: [{backend: sim}]\n", "cameras: 1 camera, at least 2 (line 1)"},
-    {"NineCameras",
-     "cameras: [{backend: sim}, {backend: sim}, {backend: sim}, {backend: sim},\n"
-     "  {backend: sim}, {backend: sim}, {backend: sim}, {backend: sim}, {backend: sim}]\n",
-     "cameras: 9 cameras, at most 8 (line 1)"},
+    {"ThirtyThreeCameras",
+     "cameras: [{backend: sim}, {backend: sim}, {backend: sim}, {backend: sim}, {backend: sim},\n"
+     "  {backend: sim}, {backend: sim}, {backend: sim}, {backend: sim}, {backend: sim},\n"
+     "  {backend: sim}, {backend: sim}, {backend: sim}, {backend: sim}, {backend: sim},\n"
+     "  {backend: sim}, {backend: sim}, {backend: sim}, {backend: sim}, {backend: sim},\n"
+     "  {backend: sim}, {backend: sim}, {backend: sim}, {backend: sim}, {backend: sim},\n"
+     "  {backend: sim}, {backend: sim}, {backend: sim}, {backend: sim}, {backend: sim},\n"
+     "  {backend: sim}, {backend: sim}, {backend: sim}]\n",
+     "cameras: 33 cameras, at most 32 (line 1)"},
     {"SimCamerasDisagree", "cameras: [{backend: sim}, {backend: sim}]\nsim: {cameras: 3}\n",
      "sim.cameras: 3 cameras, but the cameras list has 2 (line 2)"},
     {"SimCamerasRange", "sim: {cameras: 9}\n", "sim.cameras: must be in [2, 8], got 9 (line 1)"},
+    {"SimHumanoidCamerasRange", "sim: {scene: humanoid, cameras: 33}\n",
+     "sim.cameras: must be in [2, 32], got 33 (line 1)"},
     {"DetectStageWithoutCamera", "pipeline: {stages: {detect2: {cpu: 0}}}\n",
      "pipeline.stages.detect2: no camera 2 (2 cameras)"},
     {"RigHasOtherCameraCount",
@@ -160,7 +167,10 @@ const ErrorCase kCases[] = {
      "pipeline.dequeue_timeout_ms: must be in [1, 1000], got 0 (line 1)"},
     {"UnknownStage", "pipeline: {stages: {triangulate: {cpu: 0}}}\n",
      "pipeline.stages.triangulate: unknown key (line 1); expected one of: capture, detect, "
-     "identify, publish, detect0, detect1, detect2, detect3, detect4, detect5, detect6, detect7"},
+     "identify, publish, detect0, detect1, detect2, detect3, detect4, detect5, detect6, detect7, "
+     "detect8, detect9, detect10, detect11, detect12, detect13, detect14, detect15, detect16, "
+     "detect17, detect18, detect19, detect20, detect21, detect22, detect23, detect24, detect25, "
+     "detect26, detect27, detect28, detect29, detect30, detect31"},
     {"UnknownStageKey", "pipeline: {stages: {detect0: {core: 0}}}\n",
      "pipeline.stages.detect0.core: unknown key (line 1); expected one of: cpu, priority, "
      "ring_depth"},

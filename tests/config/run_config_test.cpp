@@ -103,6 +103,37 @@ TEST(RunConfig, NodeKeysAreRead) {
   EXPECT_EQ(central->pipeline.pair_tolerance_us, 500);
 }
 
+// A rig of more than 8 cameras over nodes (kMaxCameras is 32): 12 node cameras, two
+// nodes of 6, load against the humanoid's 12-camera ring; a node itself takes at most 8.
+TEST(RunConfig, TwelveNodeCamerasLoadAndANodeTakesAtMostEight) {
+  TempDir dir("cfg_node12");
+  sim::SimOptions so;
+  so.scene = sim::SceneKind::kHumanoid;
+  so.cameras = 12;
+  auto scene = sim::make_scene(so);
+  ASSERT_TRUE(scene) << scene.error().message;
+  ASSERT_TRUE(save_rig(dir.file("rig.yaml"), scene->rig));
+  ASSERT_TRUE(save_targets(dir.file("targets.yaml"), scene->targets));
+  std::string yaml = "rig: rig.yaml\ntargets: targets.yaml\ncameras:\n";
+  for (int c = 0; c < 12; ++c)
+    yaml += "  - {backend: node, device: n" + std::to_string(c / 6) + "/cam" + std::to_string(c) +
+            "}\n";
+  write_file(dir.file("central.yaml"), yaml);
+  auto central = load_run_config(dir.file("central.yaml"));
+  ASSERT_TRUE(central) << central.error().message;
+  ASSERT_EQ(central->cameras.size(), 12u);
+  EXPECT_EQ(central->cameras[11].device, "n1/cam11");
+  std::string node = "cameras:\n";
+  for (int c = 0; c < 9; ++c)
+    node += "  - {backend: v4l2, device: /dev/video" + std::to_string(c) +
+            ", width: 640, height: 480}\n";
+  write_file(dir.file("node.yaml"), node);
+  auto nine = load_run_config(dir.file("node.yaml"), false, ConfigRole::kNode);
+  ASSERT_FALSE(nine);
+  EXPECT_EQ(nine.error().message,
+            dir.file("node.yaml") + ": cameras: 9 cameras, at most 8 (line 2)");
+}
+
 TEST(RunConfig, ThresholdsAndOutputsAreRead) {
   TempDir dir("cfg_thr");
   write_file(dir.file("m.yaml"),

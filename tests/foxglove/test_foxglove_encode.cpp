@@ -337,14 +337,13 @@ TEST(FoxgloveBlobOverlay, DrawsEachBlobWhereTheCameraSeesItInItsGreyLevel) {
   publish::CameraBlobs& cb = f->cameras[1];
   cb.present = 1;
   cb.count = 5;
-  cb.blobs[0] = {400.0f, 200.0f, 12.0f, static_cast<std::uint8_t>(publish::BlobUse::kMarker),
-                 1,      2,      0};
-  cb.blobs[1] = {800.0f, 600.0f, 8.0f, static_cast<std::uint8_t>(publish::BlobUse::kPoint),
-                 0,      0,      0};
-  cb.blobs[2] = {101.0f, 101.0f, 2.0f, static_cast<std::uint8_t>(publish::BlobUse::kUnused),
-                 0,      0,      0};
-  cb.blobs[3] = {NAN, 5.0f, 8.0f, 0, 0, 0, 0};
-  cb.blobs[4] = {-1e30f, 1e30f, 1e30f, 0, 0, 0, 0};
+  cb.first = 7;  // anywhere in the frame's blobs
+  publish::ResultBlob* const blobs = f->blobs_of(1);
+  blobs[0] = {400.0f, 200.0f, 12.0f, static_cast<std::uint8_t>(publish::BlobUse::kMarker), 1, 2, 0};
+  blobs[1] = {800.0f, 600.0f, 8.0f, static_cast<std::uint8_t>(publish::BlobUse::kPoint), 0, 0, 0};
+  blobs[2] = {101.0f, 101.0f, 2.0f, static_cast<std::uint8_t>(publish::BlobUse::kUnused), 0, 0, 0};
+  blobs[3] = {NAN, 5.0f, 8.0f, 0, 0, 0, 0};
+  blobs[4] = {-1e30f, 1e30f, 1e30f, 0, 0, 0, 0};
   const json j = json::parse(encode_blob_overlay(scene, *f, 1, 1500000000));
   EXPECT_EQ(j["frame_id"], "right");
   EXPECT_EQ(j["encoding"], "mono8");

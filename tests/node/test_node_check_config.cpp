@@ -3,7 +3,8 @@
 // /dev/video0 is never opened, and replay cameras of the node_recording fixture); exit 1
 // and exactly one line naming the file and the key for each kind of bad input (an unknown
 // key, a backend a node cannot run, a recording camera that does not exist, two cameras
-// publishing the same name). No DDS and no camera is touched.
+// publishing the same name, 9 cameras: a node publishes at most 8). No DDS and no camera is
+// touched.
 #include <gtest/gtest.h>
 
 #include <string>
@@ -71,6 +72,16 @@ TEST(NodeCheckConfig, RejectsBadInputWithOneLineNamingFileAndKey) {
        "cameras:\n  - {backend: replay, device: " + rec +
            ", camera: cam2}\n  - {backend: replay, device: " + rec + ", camera: cam2}\n",
        "cameras[1]: publishes camera 'cam2' as cameras[0] does"},
+      {"nine.yaml",
+       "cameras:\n" +
+           [] {
+             std::string list;
+             for (int c = 0; c < 9; ++c)
+               list += "  - {backend: v4l2, device: /dev/video" + std::to_string(c) +
+                       ", width: 640, height: 480}\n";
+             return list;
+           }(),
+       "cameras: 9 cameras, at most 8 (line 2)"},
       {"no_recording.yaml",
        "cameras:\n  - {backend: replay, device: " + dir.file("nothing") + "}\n",
        "cameras[0].device: "},

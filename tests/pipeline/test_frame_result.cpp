@@ -4,7 +4,8 @@
 // as qw>=0 quaternion + translation, its labelled markers with the residual to the
 // posed model marker (unmatched markers left out), the points with reprojection error
 // and camera count, and each camera's blobs with what they became; which points a body
-// claimed (ResultPoint::labelled, also behind points that are not reported); no allocation.
+// claimed (ResultPoint::labelled, also behind points that are not reported); no allocation;
+// 12 cameras share the result's blobs.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -162,26 +163,70 @@ TEST(FrameResultBuilder, BlobsSayWhatTheyBecame) {
     EXPECT_EQ(scope.count(), 0u);
   }
   using publish::BlobUse;
-  const auto use = [&](int c, int i) {
-    return static_cast<BlobUse>(
-        r->cameras[static_cast<std::size_t>(c)].blobs[static_cast<std::size_t>(i)].use);
-  };
+  const auto use = [&](int c, int i) { return static_cast<BlobUse>(r->blobs_of(c)[i].use); };
   ASSERT_EQ(r->camera_count, 2);
   EXPECT_EQ(r->cameras[0].present, 1);
   EXPECT_EQ(r->cameras[1].present, 0);
   ASSERT_EQ(r->cameras[0].count, 4);
-  EXPECT_FLOAT_EQ(r->cameras[0].blobs[3].x_px, 130.0f);
-  EXPECT_FLOAT_EQ(r->cameras[1].blobs[0].y_px, 51.0f);
-  EXPECT_NEAR(r->cameras[0].blobs[0].diameter_px, 10.0f, 1e-4f);
+  EXPECT_FLOAT_EQ(r->blobs_of(0)[3].x_px, 130.0f);
+  EXPECT_FLOAT_EQ(r->blobs_of(1)[0].y_px, 51.0f);
+  EXPECT_NEAR(r->blobs_of(0)[0].diameter_px, 10.0f, 1e-4f);
   EXPECT_EQ(use(0, 0), BlobUse::kMarker);
   EXPECT_EQ(use(1, 0), BlobUse::kMarker);
-  EXPECT_EQ(r->cameras[0].blobs[0].body, 0);
-  EXPECT_EQ(r->cameras[0].blobs[0].marker, 0);
+  EXPECT_EQ(r->blobs_of(0)[0].body, 0);
+  EXPECT_EQ(r->blobs_of(0)[0].marker, 0);
   EXPECT_EQ(use(0, 1), BlobUse::kPoint);
   EXPECT_EQ(use(1, 2), BlobUse::kPoint);
   EXPECT_EQ(use(0, 2), BlobUse::kUnused);
   EXPECT_EQ(use(1, 1), BlobUse::kUnused);
   EXPECT_EQ(use(0, 3), BlobUse::kUnused);
+}
+
+// More than 8 cameras share the result's blobs (kMaxResultBlobTotal): 12 cameras of 200
+// blobs keep 2048 / 12 = 170 each, in consecutive ranges, and a point seen by cameras 9
+// and 11 (camera mask bits above 7) marks its blobs there.
+TEST(FrameResultBuilder, TwelveCamerasShareTheBlobsAndMarkTheirUses) {
+  constexpr int kCams = 12;
+  TargetSet targets;
+  auto out = std::make_unique<FrameOutput>();
+  out->points.set_capacity(4);
+  out->blobs.resize(kCams);
+  for (int c = 0; c < kCams; ++c) {
+    out->blobs[static_cast<std::size_t>(c)] = detect::BlobList(256);
+    out->camera_present[static_cast<std::size_t>(c)] = true;
+    for (int i = 0; i < 200; ++i) {
+      detect::Blob b;
+      b.x_px = 1000.0 * c + i;
+      ASSERT_TRUE(out->blobs[static_cast<std::size_t>(c)].push_back(b));
+    }
+  }
+  Point3 p;
+  p.reported = true;
+  p.blob_index[9] = 5;
+  p.blob_index[11] = 169;
+  ASSERT_TRUE(out->points.push_back(p));
+  p.blob_index = BlobRefs{};
+  p.blob_index[10] = 170;  // beyond camera 10's share: left out
+  p.blob_index[11] = 3;
+  ASSERT_TRUE(out->points.push_back(p));
+  auto r = std::make_unique<publish::FrameResult>();
+  auto labelled = std::make_unique<LabelledMarkers>();
+  make_frame_result(1, 0, targets, *out, *labelled, *r);
+  ASSERT_EQ(r->camera_count, kCams);
+  EXPECT_EQ(publish::result_blobs_per_camera(kCams), 170);
+  for (int c = 0; c < kCams; ++c) {
+    EXPECT_EQ(r->cameras[static_cast<std::size_t>(c)].count, 170) << c;
+    EXPECT_EQ(r->cameras[static_cast<std::size_t>(c)].first, 170 * c) << c;
+    EXPECT_FLOAT_EQ(r->blobs_of(c)[169].x_px, 1000.0f * static_cast<float>(c) + 169.0f) << c;
+  }
+  using publish::BlobUse;
+  const auto use = [&](int c, int i) { return static_cast<BlobUse>(r->blobs_of(c)[i].use); };
+  EXPECT_EQ(use(9, 5), BlobUse::kPoint);
+  EXPECT_EQ(use(11, 169), BlobUse::kPoint);
+  EXPECT_EQ(use(11, 3), BlobUse::kPoint);
+  EXPECT_EQ(use(9, 4), BlobUse::kUnused);
+  EXPECT_EQ(use(10, 169), BlobUse::kUnused);
+  EXPECT_EQ(use(8, 5), BlobUse::kUnused);
 }
 
 // ResultPoint::labelled: the points a body claimed, mapped through the points that are

@@ -69,8 +69,7 @@ TEST(HumanoidOutputs, FullFrameFillsTheFrameResult) {
     const publish::CameraBlobs& cb = r->cameras[static_cast<std::size_t>(c)];
     EXPECT_EQ(cb.count, h->out->blobs[static_cast<std::size_t>(c)].size());
     for (int i = 0; i < cb.count; ++i)
-      marker_blobs += cb.blobs[static_cast<std::size_t>(i)].use ==
-                      static_cast<std::uint8_t>(publish::BlobUse::kMarker);
+      marker_blobs += r->blobs_of(c)[i].use == static_cast<std::uint8_t>(publish::BlobUse::kMarker);
   }
   EXPECT_GT(marker_blobs, kMarkers);  // most markers are in more than one view
 }

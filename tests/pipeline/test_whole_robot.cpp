@@ -115,8 +115,7 @@ TEST(WholeRobot, ThirtyTwoBodiesFillTheFrameResult) {
     const publish::CameraBlobs& cb = r->cameras[static_cast<std::size_t>(c)];
     EXPECT_EQ(cb.count, kBlobsPerCamera) << "every blob of camera " << c;
     for (int i = 0; i < cb.count; ++i)
-      marker_blobs += cb.blobs[static_cast<std::size_t>(i)].use ==
-                      static_cast<std::uint8_t>(publish::BlobUse::kMarker);
+      marker_blobs += r->blobs_of(c)[i].use == static_cast<std::uint8_t>(publish::BlobUse::kMarker);
   }
   EXPECT_EQ(marker_blobs, 2 * kBodies * kMarkersPerBody);  // two views per marker
 }

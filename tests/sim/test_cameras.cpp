@@ -1,10 +1,12 @@
-// Tests of 2..8 cameras (`mocap simulate --cameras N`, `--rig` with 2..8 cameras): the
+// Tests of 2..8 cameras (`mocap simulate --cameras N`, `--rig` with 2..32 cameras): the
 // built-in pair is exactly the pair it always was; every camera of the built-in 3..8
 // camera arcs passes the scene-in-view check and the 4 cameras look from clearly
 // different directions, so that limbs hide markers from some cameras and not others;
 // a 3-camera user rig renders into 3 folders with per-camera ground-truth columns; a
-// 4-camera wand recording has 4 cameras in gt/rig_true.yaml; 1 and 9 cameras are
-// one-line errors. Lean: at most a few frames are rendered.
+// 4-camera wand recording has 4 cameras in gt/rig_true.yaml; the humanoid's ring takes
+// up to 32 cameras (12: all in view, all aimed at the robot, its first 8 lenses those of
+// the 8-camera ring); 1 and 9 cameras of the arc, 33 of a rig, are one-line errors.
+// Lean: at most a few frames are rendered.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -89,7 +91,7 @@ TEST(SimCameras, TwoCamerasAreThePreviousBuiltInPair) {
 }
 
 TEST(SimCameras, EveryBuiltInArcPassesTheSceneCheck) {
-  for (int n = 3; n <= kMaxSimCameras; ++n) {
+  for (int n = 3; n <= kMaxArcCameras; ++n) {
     SimOptions opt;
     opt.cameras = n;
     auto scene = make_scene(opt);  // runs the check itself
@@ -104,6 +106,33 @@ TEST(SimCameras, EveryBuiltInArcPassesTheSceneCheck) {
       EXPECT_TRUE(r.ok()) << n << " cameras, camera " << c << ": " << r.error().message;
     }
   }
+}
+
+TEST(SimCameras, TheHumanoidRingTakesMoreThanEightCameras) {
+  SimOptions opt;
+  opt.scene = SceneKind::kHumanoid;
+  opt.cameras = 12;
+  auto twelve = make_scene(opt);  // runs the scene check itself
+  ASSERT_TRUE(twelve.ok()) << twelve.error().message;
+  ASSERT_EQ(twelve->rig.cameras.size(), 12u);
+  EXPECT_TRUE(check_rig_for_scene(twelve->rig, *twelve, "ring").ok());
+  opt.cameras = 8;
+  auto eight = make_scene(opt);
+  ASSERT_TRUE(eight.ok()) << eight.error().message;
+  for (std::size_t c = 0; c < 12; ++c) {
+    const CameraModel& cam = twelve->rig.cameras[c];
+    EXPECT_EQ(cam.name, "cam" + std::to_string(c));
+    const Vec3 z = cam.R_cam_world.row(2).transpose();
+    const Vec3 to_center = twelve->robot_center_world - cam.center_world();
+    EXPECT_GT(z.dot(to_center.normalized()), 0.999) << c;
+    EXPECT_EQ(cam.fx, eight->rig.cameras[c % 8].fx) << c;  // lens k % 8
+    for (std::size_t d = 0; d < c; ++d)                    // 30 deg apart on the ring
+      EXPECT_GT((cam.center_world() - twelve->rig.cameras[d].center_world()).norm(), 1000.0);
+  }
+  opt.cameras = 33;
+  auto too_many = make_scene(opt);
+  ASSERT_FALSE(too_many.ok());
+  EXPECT_EQ(too_many.error().message, "simulate: cameras: must be 2..32 for this scene, got 33");
 }
 
 TEST(SimCameras, FourCamerasSeeTheRobotFromDifferentSides) {
@@ -256,12 +285,13 @@ TEST(SimCameras, OneAndNineCamerasAreOneLineErrors) {
     opt.cameras = n;
     auto s = make_scene(opt);
     ASSERT_FALSE(s.ok()) << n;
-    EXPECT_EQ(s.error().message, "simulate: cameras: must be 2..8, got " + std::to_string(n));
+    EXPECT_EQ(s.error().message,
+              "simulate: cameras: must be 2..8 for this scene, got " + std::to_string(n));
   }
   test::TempDir dir("sim_rig19");
   auto pair = make_scene(SimOptions{});
   ASSERT_TRUE(pair.ok());
-  for (int n : {1, 9}) {
+  for (int n : {1, 33}) {
     Rig rig;
     for (int c = 0; c < n; ++c) {
       rig.cameras.push_back(pair->rig.cameras[static_cast<std::size_t>(c % 2)]);
@@ -273,10 +303,10 @@ TEST(SimCameras, OneAndNineCamerasAreOneLineErrors) {
     opt.rig_path = path;
     auto s = make_scene(opt);
     ASSERT_FALSE(s.ok()) << n;
-    // 9 cameras: the rig reader already refuses more than kMaxCameras.
+    // 33 cameras: the rig reader already refuses more than kMaxCameras.
     const std::string expected =
-        n == 9 ? path + ": cameras: 9 cameras, at most 8 are supported"
-               : path + ": cameras: the simulator renders 2 to 8 cameras, the rig has 1";
+        n == 33 ? path + ": cameras: 33 cameras, at most 32 are supported"
+                : path + ": cameras: the simulator renders 2 to 32 cameras, the rig has 1";
     EXPECT_EQ(s.error().message.rfind(expected, 0), 0u) << s.error().message;
     EXPECT_EQ(s.error().message.find('\n'), std::string::npos);
   }

@@ -1,6 +1,6 @@
 // Command tests: `mocap simulate` writes a 100-frame recording end to end, prints one
 // summary line, writes 4-camera recordings (--cameras 4, also --motion wand), and
-// rejects bad options (also 1 and 9 cameras) with a one-line error.
+// rejects bad options (also 1 and 9 cameras, 33 of the humanoid) with a one-line error.
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -92,7 +92,8 @@ TEST(SimCommand, BadOptionsGiveOneLineErrors) {
   for (const char* args :
        {"--bits 12", "--motion wobble", "--frames 0", "--dropout 1.5", "--blur -1",
         "--motion poses --frames 5", "--bits 16 --maxval 70000", "--fps 0", "--noise -1",
-        "--scene arms", "--cameras 1", "--cameras 9", "--cameras 0", "--cameras 9 --motion wand"}) {
+        "--scene arms", "--cameras 1", "--cameras 9", "--cameras 0", "--cameras 9 --motion wand",
+        "--scene humanoid --cameras 33"}) {
     const auto r = test::run_mocap("simulate --out " + out + " " + std::string(args));
     EXPECT_NE(r.exit_code, 0) << args;
     EXPECT_EQ(test::line_count(r.output), 1) << args << ": " << r.output;

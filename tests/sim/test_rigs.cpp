@@ -154,11 +154,11 @@ TEST(SimRigs, BadRigsGiveOneLineErrors) {
   std::vector<Case> cases;
   {
     Rig r = *base;
-    for (int c = 2; c < 9; ++c) {
+    for (int c = 2; c < 33; ++c) {
       r.cameras.push_back(r.cameras[0]);
       r.cameras.back().name = "cam" + std::to_string(c);
     }
-    cases.push_back({"nine", r, "cameras: 9 cameras, at most 8 are supported"});
+    cases.push_back({"thirty-three", r, "cameras: 33 cameras, at most 32 are supported"});
   }
   {
     Rig r = *base;  // cam1 turned round: the robot is behind it

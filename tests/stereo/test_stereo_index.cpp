@@ -45,8 +45,8 @@ bool identical(const Point3& a, const Point3& b) {
 }
 
 bool by_blobs(const Point3& a, const Point3& b) {
-  return std::lexicographical_compare(a.blob_index.begin(), a.blob_index.end(),
-                                      b.blob_index.begin(), b.blob_index.end());
+  return std::lexicographical_compare(a.blob_index.indices().begin(), a.blob_index.indices().end(),
+                                      b.blob_index.indices().begin(), b.blob_index.indices().end());
 }
 
 std::vector<Point3> sorted(const PointList& l) {

@@ -354,7 +354,8 @@ TEST(StereoMatching, CameraPairsAreEnumeratedLexicographically) {
   EXPECT_EQ(pairs[1].b, 2);
   EXPECT_EQ(pairs[2].a, 1);
   EXPECT_EQ(pairs[2].b, 2);
-  EXPECT_EQ(enumerate_camera_pairs(9, pairs), kMaxCameraPairs);  // capped at kMaxCameras
+  EXPECT_EQ(enumerate_camera_pairs(12, pairs), 66);
+  EXPECT_EQ(enumerate_camera_pairs(33, pairs), 496);  // capped at kMaxCameras (32)
   EXPECT_EQ(pairs[kMaxCameraPairs - 1].a, kMaxCameras - 2);
   EXPECT_EQ(pairs[kMaxCameraPairs - 1].b, kMaxCameras - 1);
 }
