@@ -9,9 +9,10 @@
 
 namespace mocap::node {
 
-Expected<std::shared_ptr<NodeLink>> NodeLink::create(std::uint32_t domain_id, double wait_s) {
+Expected<std::shared_ptr<NodeLink>> NodeLink::create(std::uint32_t domain_id, double wait_s,
+                                                     bool realtime) {
   std::shared_ptr<NodeLink> l(new NodeLink());
-  auto d = NodeDomain::open(domain_id, "mocap run: nodes");
+  auto d = NodeDomain::open(domain_id, "mocap run: nodes", realtime);
   if (!d) return d.error();
   l->domain_ = std::move(d).value();
   auto r = l->domain_.reader(l->domain_.blob_topic(), "mocap run: mocap/blobs");
@@ -28,6 +29,7 @@ Expected<std::shared_ptr<NodeLink>> NodeLink::create(std::uint32_t domain_id, do
   if (!ring) return ring.error();
   l->triggers_ = std::make_unique<rt::SpscRing<std::uint64_t>>(std::move(ring).value());
   l->wait_s_ = wait_s;
+  l->realtime_ = realtime;
   return l;
 }
 
@@ -68,15 +70,23 @@ Expected<void> NodeLink::start() {
   stop_.store(false, std::memory_order_relaxed);  // no thread runs yet
   next_trigger_ = 0;
   received_end_.store(0, std::memory_order_relaxed);  // no thread runs yet
-  auto a = rt::start_thread(rt::ThreadSpec{"mocap-nrecv", -1, 0}, [this] { receive_loop(); });
+  const int priority = realtime_ ? kDdsFifoPriority : 0;
+  auto a =
+      rt::start_thread(rt::ThreadSpec{"mocap-nrecv", -1, priority}, [this] { receive_loop(); });
   if (!a) return a.error();
   receive_thread_ = std::move(a).value();
-  auto b = rt::start_thread(rt::ThreadSpec{"mocap-ntrig", -1, 0}, [this] { trigger_loop(); });
+  auto b =
+      rt::start_thread(rt::ThreadSpec{"mocap-ntrig", -1, priority}, [this] { trigger_loop(); });
   if (!b) return b.error();
   trigger_thread_ = std::move(b).value();
+  notice_.clear();
   if (!wait_for_nodes(wait_s_)) {
     notice_ = "not every node was discovered within " + std::to_string(wait_s_) +
               " s: their cameras count as missing until they appear";
+  }
+  for (const rt::RtThread* t : {&receive_thread_, &trigger_thread_}) {
+    if (t->setup().note.empty()) continue;
+    notice_ += (notice_.empty() ? "" : "; ") + t->setup().note;
   }
   return {};
 }

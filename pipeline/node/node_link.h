@@ -1,6 +1,7 @@
 // Design: the central tracker's side of the camera nodes (issue 29): one NodeLink per
 // `mocap run` (shared by its NodeCameras, node_camera.h) holds the DDS participant and
-//   - the receiver thread (`mocap-nrecv`, not real-time): takes mocap/blobs samples,
+//   - the receiver thread (`mocap-nrecv`, SCHED_FIFO kDdsFifoPriority when realtime, as
+//     the trigger thread): takes mocap/blobs samples,
 //     finds the camera by (node, camera) name, checks and decodes the message
 //     (node_wire.h: malformed and oversized messages are counted per node and dropped)
 //     into a slot of that camera's inbox (rt::SlotPool, receiver -> capture thread;
@@ -50,7 +51,9 @@ struct NodeStats {
 
 class NodeLink {
  public:
-  static Expected<std::shared_ptr<NodeLink>> create(std::uint32_t domain_id, double wait_s);
+  // realtime: its threads and Cyclone's receive thread at SCHED_FIFO kDdsFifoPriority.
+  static Expected<std::shared_ptr<NodeLink>> create(std::uint32_t domain_id, double wait_s,
+                                                    bool realtime);
   ~NodeLink();
 
   // Setup (before start): camera `camera` of node `node`; its inbox holds `slots`
@@ -61,7 +64,8 @@ class NodeLink {
   pipeline::Doorbell& bell() noexcept { return bell_; }
 
   // Reference-counted by the cameras' start()/stop(): the first start starts the threads
-  // and waits for the nodes; one line on nodes not seen goes to notice().
+  // and waits for the nodes; one line on nodes not seen (and on what of realtime was not
+  // applied) goes to notice().
   Expected<void> start();
   void stop() noexcept;
   const std::string& notice() const noexcept { return notice_; }
@@ -100,6 +104,7 @@ class NodeLink {
   NodeDomain domain_;
   dds_entity_t reader_ = 0, writer_ = 0, waitset_ = 0;
   double wait_s_ = 10.0;
+  bool realtime_ = false;
   struct Camera {
     std::string node, camera;
     int node_index = 0;

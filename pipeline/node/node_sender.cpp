@@ -7,12 +7,12 @@ namespace mocap::node {
 
 Expected<std::unique_ptr<NodeSender>> NodeSender::create(std::uint32_t domain_id,
                                                          const std::vector<bool>& central,
-                                                         int queue_depth) {
+                                                         int queue_depth, bool realtime) {
   const int n = static_cast<int>(central.size());
   if (n < 1 || n > kMaxNodeCameras)
     return make_error("mocap node", "cameras", "1.." + std::to_string(kMaxNodeCameras));
   std::unique_ptr<NodeSender> s(new NodeSender());
-  auto d = NodeDomain::open(domain_id, "mocap node");
+  auto d = NodeDomain::open(domain_id, "mocap node", realtime);
   if (!d) return d.error();
   s->domain_ = std::move(d).value();
   auto w = s->domain_.writer(s->domain_.blob_topic(), "mocap node: mocap/blobs");
@@ -26,6 +26,7 @@ Expected<std::unique_ptr<NodeSender>> NodeSender::create(std::uint32_t domain_id
   if (s->waitset_ < 0 || cond < 0 || dds_waitset_attach(s->waitset_, cond, 0) < 0)
     return make_error("mocap node", "mocap/trigger", "cannot create the DDS waitset");
   s->central_ = central;
+  s->realtime_ = realtime;
   s->trigger_bells_ = std::make_unique<pipeline::Doorbell[]>(static_cast<std::size_t>(n));
   for (int c = 0; c < n; ++c) {
     auto q = rt::DropOldestQueue<WireFrame>::create(queue_depth);
@@ -42,15 +43,20 @@ NodeSender::~NodeSender() { stop(false); }
 
 Expected<void> NodeSender::start() {
   stop_.store(false, std::memory_order_relaxed);  // no thread runs yet
-  auto a = rt::start_thread(rt::ThreadSpec{"mocap-nsend", -1, 0}, [this] { send_loop(); });
+  notes_.clear();
+  const int priority = realtime_ ? kDdsFifoPriority : 0;
+  auto a = rt::start_thread(rt::ThreadSpec{"mocap-nsend", -1, priority}, [this] { send_loop(); });
   if (!a) return a.error();
   send_thread_ = std::move(a).value();
-  auto b = rt::start_thread(rt::ThreadSpec{"mocap-ntrig", -1, 0}, [this] { trigger_loop(); });
+  auto b =
+      rt::start_thread(rt::ThreadSpec{"mocap-ntrig", -1, priority}, [this] { trigger_loop(); });
   if (!b) {
     stop(false);
     return b.error();
   }
   trigger_thread_ = std::move(b).value();
+  for (const rt::RtThread* t : {&send_thread_, &trigger_thread_})
+    if (!t->setup().note.empty()) notes_.push_back(t->setup().note);
   return {};
 }
 

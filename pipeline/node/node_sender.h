@@ -1,10 +1,11 @@
 // Design: the DDS side of `mocap node` (issue 29), two non-real-time threads between the
 // node's camera threads (node_runner.h) and the network:
-//   - sender (`mocap-nsend`): takes every camera's messages from its bounded drop-oldest
+//   - sender (`mocap-nsend`, SCHED_FIFO kDdsFifoPriority when realtime): takes every camera's
+//   messages from its bounded drop-oldest
 //     queue (rt::DropOldestQueue<WireFrame>, one per camera: one producer each; drops are
 //     counted and reported in the camera's health), stamps sent_ns and writes them to
 //     mocap/blobs. The camera threads never touch DDS (it locks and allocates).
-//   - trigger reader (`mocap-ntrig`): takes mocap/trigger samples and hands each trigger
+//   - trigger reader (`mocap-ntrig`, the same): takes mocap/trigger samples and hands each trigger
 //     (number, central send time, node receive time) to every camera with `trigger:
 //     central` through its SPSC ring, then rings that camera's doorbell.
 // Setup allocates (queues of depth x 139 KiB per camera); the camera-thread side
@@ -35,12 +36,14 @@ struct TriggerStamp {
 class NodeSender {
  public:
   // central[c]: camera c follows the central triggers. queue_depth: messages per camera.
+  // realtime: both threads and Cyclone's receive thread at SCHED_FIFO kDdsFifoPriority.
   static Expected<std::unique_ptr<NodeSender>> create(std::uint32_t domain_id,
                                                       const std::vector<bool>& central,
-                                                      int queue_depth);
+                                                      int queue_depth, bool realtime);
   ~NodeSender();
 
-  Expected<void> start();
+  Expected<void> start();  // notes(): what of realtime was not applied
+  const std::vector<std::string>& notes() const noexcept { return notes_; }
   // Stops both threads; first sends what is queued and waits (bounded) for the readers'
   // acknowledgements when `flush`.
   void stop(bool flush) noexcept;
@@ -69,6 +72,8 @@ class NodeSender {
   NodeDomain domain_;
   dds_entity_t writer_ = 0, trigger_reader_ = 0, waitset_ = 0;
   std::vector<bool> central_;
+  bool realtime_ = false;
+  std::vector<std::string> notes_;
   std::vector<std::unique_ptr<rt::DropOldestQueue<WireFrame>>> queues_;
   std::vector<std::unique_ptr<rt::SpscRing<TriggerStamp>>> triggers_;
   std::unique_ptr<pipeline::Doorbell[]> trigger_bells_;
