@@ -75,14 +75,15 @@ struct CameraConfig {
 // latency_origin_ns() is the LOCAL instant this process's latency statistics start at.
 // For a live camera they are the same instant (the exposure/trigger on this host's
 // CLOCK_MONOTONIC) and `delivered_ns` stays 0; a replay keeps the recording's timestamps
-// as the data's and sets `delivered_ns` to the instant it delivered the frame.
+// as the data's and sets `delivered_ns` to the instant of the software trigger that
+// released the frame (free-running: the instant it delivered the frame).
 struct Frame {
   ImageView image;                 // empty when `missing`
   std::uint64_t sequence = 0;      // trigger/frame sequence number (per camera, from 0)
   std::int64_t timestamp_ns = 0;   // exposure/trigger time, CLOCK_MONOTONIC (replay: the
                                    // recording's timestamp)
   std::int64_t received_ns = 0;    // when dequeue returned it, CLOCK_MONOTONIC
-  std::int64_t delivered_ns = 0;   // replay: when it delivered the frame, CLOCK_MONOTONIC;
+  std::int64_t delivered_ns = 0;   // replay: its trigger (or delivery), CLOCK_MONOTONIC;
                                    // 0: timestamp_ns is local (live cameras)
   std::uint32_t buffer_index = 0;  // backend buffer; used by release()
   bool missing = false;            // replay: this camera has no image for this frame
@@ -92,7 +93,7 @@ struct Frame {
 };
 
 // The local CLOCK_MONOTONIC instant a frame's latencies are measured from: the exposure/
-// trigger time of a live camera, the delivery of a replayed frame (see Frame).
+// trigger time of a live camera, a replayed frame's trigger or delivery (see Frame).
 inline std::int64_t latency_origin_ns(const Frame& f) noexcept {
   return f.delivered_ns != 0 ? f.delivered_ns : f.timestamp_ns;
 }

@@ -86,7 +86,7 @@ Expected<void> ReplayCamera::start() {
   held_.assign(static_cast<std::size_t>(config_.buffer_count), false);
   next_ = 0;
   skipped_ = 0;
-  triggers_ = 0;
+  triggered_ = released_ = 0;
   reset_sequence();
   start_ns_ = monotonic_ns();
   state_ = CameraState::kStreaming;
@@ -102,7 +102,8 @@ ReplayCamera::~ReplayCamera() = default;
 CameraStatus ReplayCamera::trigger() noexcept {
   if (state_ != CameraState::kStreaming) return CameraStatus::kNotStreaming;
   if (config_.trigger != TriggerMode::kSoftware) return CameraStatus::kUnsupported;
-  ++triggers_;
+  trigger_ns_[triggered_ % kTriggerTimes] = monotonic_ns();
+  ++triggered_;
   return CameraStatus::kOk;
 }
 
@@ -125,7 +126,7 @@ CameraStatus ReplayCamera::dequeue(Frame& out, int timeout_ms) noexcept {
   const std::int64_t now = monotonic_ns();
   const std::int64_t timeout_ns = static_cast<std::int64_t>(timeout_ms) * 1'000'000;
   if (config_.trigger == TriggerMode::kSoftware) {
-    if (triggers_ == 0) {  // nothing can arrive while this thread waits
+    if (triggered_ == released_) {  // nothing can arrive while this thread waits
       if (timeout_ms > 0) sleep_until_ns(now + timeout_ns);
       counters_.timeouts.add();
       return CameraStatus::kTimeout;
@@ -159,7 +160,13 @@ CameraStatus ReplayCamera::dequeue(Frame& out, int timeout_ms) noexcept {
   }
   const FrameEntry& entry = frames[loaded.frame_index];  // == next_: loaded in order
   next_ = loaded.frame_index + 1;
-  if (config_.trigger == TriggerMode::kSoftware) --triggers_;
+  // Where the latencies start: the trigger that released the frame (a live camera's
+  // exposure starts there too), else the delivery.
+  std::int64_t origin_ns = 0;
+  if (config_.trigger == TriggerMode::kSoftware) {
+    const std::uint64_t t = released_++;
+    if (triggered_ - t <= kTriggerTimes) origin_ns = trigger_ns_[t % kTriggerTimes];
+  }
   bool missing = true;
   if (loaded.status == ReplayReadAhead::Status::kError) {
     counters_.errors.add();  // malformed or wrong format: delivered as missing
@@ -176,7 +183,7 @@ CameraStatus ReplayCamera::dequeue(Frame& out, int timeout_ms) noexcept {
   out.sequence = sequence;
   out.timestamp_ns = entry.timestamp_ns;  // the data's time: the recording's
   out.received_ns = monotonic_ns();
-  out.delivered_ns = out.received_ns;  // latencies start here (hal/camera.h, Frame)
+  out.delivered_ns = origin_ns != 0 ? origin_ns : out.received_ns;  // hal/camera.h, Frame
   out.buffer_index = b;
   out.missing = missing;
   counters_.frames.add();

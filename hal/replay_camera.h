@@ -8,8 +8,11 @@
 // disk behind the replay) is waited for within dequeue's timeout, then kTimeout, as a
 // camera whose frame has not arrived; none is skipped. Frame sequence = the recording's frame
 // number, timestamp_ns = its timestamp_ns (the data's capture time, published unchanged),
-// delivered_ns = the CLOCK_MONOTONIC instant dequeue delivered it (image loaded): the
-// origin of the live pipeline's latencies (hal::latency_origin_ns). A frame whose file
+// delivered_ns = the origin of the live pipeline's latencies (hal::latency_origin_ns),
+// CLOCK_MONOTONIC: software-triggered, the instant of the trigger() that released the
+// frame (where a live camera's exposure starts, and where a camera node's latencies
+// start: the read-ahead's and dequeue's delays count); otherwise the instant dequeue
+// delivered it. A frame whose file
 // is absent (or malformed, or of the wrong pixel format) is delivered with missing =
 // true and an empty image, and the replay goes on; after the last frame dequeue returns
 // kEndOfStream.
@@ -23,6 +26,7 @@
 // (hal/camera_base.h).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -65,8 +69,12 @@ class ReplayCamera final : public CameraBase {
   ReplayPacing pacing_;
   std::unique_ptr<ReplayReadAhead> ahead_;  // from start(): the loaded frames
   std::vector<bool> held_;
-  std::size_t next_ = 0;        // index into recording_->frames()
-  std::uint64_t triggers_ = 0;  // software triggers not yet consumed
+  std::size_t next_ = 0;  // index into recording_->frames()
+  // Software triggers fired and consumed (released frames), and the instants of the last
+  // kTriggerTimes fired: a frame's latency origin.
+  static constexpr std::size_t kTriggerTimes = 64;
+  std::uint64_t triggered_ = 0, released_ = 0;
+  std::array<std::int64_t, kTriggerTimes> trigger_ns_{};
   std::int64_t start_ns_ = 0;
   std::uint64_t skipped_ = 0;  // the capture thread's
 };

@@ -5,10 +5,14 @@
 #   (b) two nodes of 4 replay cameras each (`trigger: central`) and a central `mocap run`
 #       with 8 `backend: node` cameras;
 # both `pipeline: {pacing: lockstep}` at 100 Hz, so every frame of the recording is
-# published, and both print `publish (end to end)` (p50, p99, p99.9, max in us): in (a)
-# from the replay's delivery of the frame, in (b) from the central trigger (the trigger's
-# way to the node, the node's replay and detection, the blob message's way back).
-# The central's report also splits (b) into its legs (`nodes:` lines).
+# published, and both print `publish (end to end)` (p50, p99, p99.9, max in us), camera 0's
+# frame's software trigger -> the frame's publication, in both on the tracker's
+# CLOCK_MONOTONIC at the same instant (the capture thread's trigger() call of camera 0):
+# in (a) the replay stamps its frame with its trigger (hal/replay_camera.h), in (b) the
+# node camera with the central trigger, so (b) adds exactly the trigger's way to the node,
+# the node's replay and detection, the blob message's way back and the central's hand-over
+# of the blobs instead of the detection. The central's report also splits (b) into its
+# legs (`node_trigger_leg`, `node_work`, `node_transit`).
 # Usage: bash bench/pipeline/node_latency.sh [MOCAP] REC [OUT] [RUNS] [REALTIME]
 #   REC: an 8-camera recording with targets.yaml and gt/model_true.yaml, e.g.
 #        `mocap simulate --scene humanoid --cameras 8 --frames 200 --out REC`;
@@ -22,6 +26,7 @@ runs=${4:-3}
 realtime=${5:-false}
 domain=$((100 + $$ % 100))
 mkdir -p "$out"
+rm -f "$out/added.txt"
 
 tracker_keys() {
   printf 'targets: %s/targets.yaml\nmodel: %s/gt/model_true.yaml\n' "$rec" "$rec"
@@ -49,6 +54,7 @@ done
 } >"$out/central.yaml"
 
 e2e() { grep -E "publish \(end to end\)|^run:" "$1" | tr -s ' '; }
+pct() { grep -E "publish \(end to end\)" "$1" | tr -s ' ' | awk '{print $6, $7}'; }  # p50 p99
 for r in $(seq 1 "$runs"); do
   "$mocap" run --config "$out/single.yaml" --stats-interval 0 >"$out/single$r.txt" 2>&1
   echo "(a) one process, run $r: $(e2e "$out/single$r.txt" | tr '\n' ' ')"
@@ -60,5 +66,13 @@ for r in $(seq 1 "$runs"); do
   kill "$n0" "$n1" 2>/dev/null || true
   wait "$n0" "$n1" 2>/dev/null || true
   echo "(b) two nodes + central, run $r: $(e2e "$out/central$r.txt" | tr '\n' ' ')"
-  grep -E "^ *nodes|transit|trigger ->|-> central" "$out/central$r.txt" | head -n 6 || true
+  # What (b) adds in this run (b - a, the same run's back-to-back pair).
+  paste <(pct "$out/single$r.txt") <(pct "$out/central$r.txt") |
+    awk -v r="$r" '{printf "added, run %s: p50 %+d us, p99 %+d us\n", r, $3 - $1, $4 - $2}' |
+    tee -a "$out/added.txt"
+  grep -E "^ *node_(trigger_leg|work|transit) " "$out/central$r.txt" || true
 done
+# The medians over the runs (the figure to compare between machines and commits).
+median() { sort -n | awk '{v[NR] = $1} END {print (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2}'; }
+echo "added, median of $runs runs: p50 $(awk '{print $5}' "$out/added.txt" | tr -d '+' | median) us," \
+  "p99 $(awk '{print $8}' "$out/added.txt" | tr -d '+' | median) us"

@@ -219,9 +219,13 @@ hal::CameraStatus NodeCamera::dequeue(hal::Frame& out, int timeout_ms) noexcept 
       return hal::CameraStatus::kTimeout;
     }
     std::int64_t wait_ns = deadline - now;
-    if (central_ && next_ < triggered_)
-      wait_ns = std::min(wait_ns, trigger_ns_[next_ % kWindow] + timeout_ns_ - now + 1);
-    bell.wait(seen, std::max<std::int64_t>(wait_ns, 1));
+    if (central_ && next_ < triggered_) {
+      // Until frame next_'s timeout, then until a message (which may show that another
+      // node answered: received_end) or the deadline: never a 1 ns poll past the timeout.
+      const std::int64_t until_timeout_ns = trigger_ns_[next_ % kWindow] + timeout_ns_ - now + 1;
+      if (until_timeout_ns > 0) wait_ns = std::min(wait_ns, until_timeout_ns);
+    }
+    bell.wait(seen, wait_ns);
   }
 }
 

@@ -3,6 +3,7 @@
 
 #include <time.h>
 
+#include <cstdlib>
 #include <cstring>
 
 #if defined(__SANITIZE_THREAD__)
@@ -29,14 +30,32 @@ Expected<dds_entity_t> check(dds_entity_t e, const std::string& who, const char*
   return e;
 }
 
+// The user's configuration (CYCLONEDDS_URI: files and/or XML, comma-separated), then one
+// receive thread at SCHED_FIFO kDdsFifoPriority.
+std::string realtime_config() {
+  std::string c;
+  if (const char* uri = std::getenv("CYCLONEDDS_URI"); uri != nullptr && uri[0] != '\0')
+    c = std::string(uri) + ",";
+  return c + "<Internal><MultipleReceiveThreads>false</MultipleReceiveThreads></Internal>" +
+         "<Threads><Thread name=\"recv\"><Scheduling><Class>realtime</Class><Priority>" +
+         std::to_string(kDdsFifoPriority) + "</Priority></Scheduling></Thread></Threads>";
+}
+
 }  // namespace
 
-Expected<NodeDomain> NodeDomain::open(std::uint32_t domain_id, const std::string& who) {
+Expected<NodeDomain> NodeDomain::open(std::uint32_t domain_id, const std::string& who,
+                                      bool realtime) {
   if (domain_id > 232) return make_error(who, "node.domain_id", "must be in 0..232");
   NodeDomain d;
+  const dds_entity_t dom =
+      realtime ? dds_create_domain(domain_id, realtime_config().c_str()) : dds_entity_t{0};
+  // PRECONDITION_NOT_MET: this process has the domain already (joined below as it is).
+  if (dom < 0 && dom != DDS_RETCODE_PRECONDITION_NOT_MET)
+    return make_error(who, "dds_create_domain", std::string("DDS: ") + dds_strretcode(dom));
   d.participant_ = dds_create_participant(domain_id, nullptr, nullptr);
   if (auto r = check(d.participant_, who, "dds_create_participant"); !r) {
     d.participant_ = 0;
+    if (dom > 0) dds_delete(dom);
     return r.error();
   }
   d.blob_topic_ =
@@ -50,7 +69,7 @@ Expected<NodeDomain> NodeDomain::open(std::uint32_t domain_id, const std::string
 
 NodeDomain& NodeDomain::operator=(NodeDomain&& o) noexcept {
   if (this != &o) {
-    if (participant_ > 0) dds_delete(participant_);
+    close();
     participant_ = o.participant_;
     blob_topic_ = o.blob_topic_;
     trigger_topic_ = o.trigger_topic_;
@@ -59,8 +78,16 @@ NodeDomain& NodeDomain::operator=(NodeDomain&& o) noexcept {
   return *this;
 }
 
-NodeDomain::~NodeDomain() {
-  if (participant_ > 0) dds_delete(participant_);
+NodeDomain::~NodeDomain() { close(); }
+
+void NodeDomain::close() noexcept {
+  if (participant_ <= 0) return;
+  const dds_entity_t domain = dds_get_parent(participant_);
+  dds_delete(participant_);
+  participant_ = blob_topic_ = trigger_topic_ = 0;
+  // An implicit domain went with its last participant; one created by open() (realtime)
+  // stays until deleted: by whoever closes its last participant (0 children left).
+  if (domain > 0 && dds_get_children(domain, nullptr, 0) == 0) dds_delete(domain);
 }
 
 Expected<dds_entity_t> NodeDomain::writer(dds_entity_t topic, const std::string& who) const {

@@ -6,6 +6,15 @@
 //   mocap/trigger  mocap_node::Trigger    central -> nodes, one per central trigger
 // QoS of both: reliable (max blocking 100 ms), keep last 32, volatile: a lockstep replay
 // loses no message on a healthy network, and a stalled peer can hold back at most 32.
+// Real-time (`pipeline.realtime`, the default): the participant's domain is created with
+// ONE Cyclone receive thread (`recv`; Internal/MultipleReceiveThreads false) at SCHED_FIFO
+// kDdsFifoPriority, after the user's CYCLONEDDS_URI (which still applies otherwise), and
+// the DDS-side threads of node_sender.h and node_link.h run at the same priority: above
+// the camera and capture threads (80), so a message or trigger never waits for a
+// detection to finish (default-policy threads waited milliseconds on a busy PC; docs/
+// performance.md). Without the privilege Cyclone starts the thread with the default policy
+// and the camera threads' notes say so. A domain this process already created (another
+// NodeDomain, the ROS 2 output) is joined as it is.
 // Setup functions allocate and return one-line errors; the sample copies are noexcept.
 #pragma once
 
@@ -23,12 +32,14 @@ namespace mocap::node {
 inline constexpr const char* kBlobTopic = "mocap/blobs";
 inline constexpr const char* kTriggerTopic = "mocap/trigger";
 inline constexpr int kHistoryDepth = 32;
+inline constexpr int kDdsFifoPriority = 85;  // Cyclone's receive thread and ours (realtime)
 
 // The participant and both topics; participant <= 0 when not open. Owns the participant
-// (deleting it deletes every entity created under it).
+// (deleting it deletes every entity created under it) and, once its last participant is
+// gone, the domain it created.
 class NodeDomain {
  public:
-  static Expected<NodeDomain> open(std::uint32_t domain_id, const std::string& who);
+  static Expected<NodeDomain> open(std::uint32_t domain_id, const std::string& who, bool realtime);
   NodeDomain() = default;
   NodeDomain(NodeDomain&& o) noexcept { *this = static_cast<NodeDomain&&>(o); }
   NodeDomain& operator=(NodeDomain&& o) noexcept;
@@ -42,6 +53,7 @@ class NodeDomain {
   Expected<dds_entity_t> reader(dds_entity_t topic, const std::string& who) const;
 
  private:
+  void close() noexcept;
   dds_entity_t participant_ = 0, blob_topic_ = 0, trigger_topic_ = 0;
 };
 

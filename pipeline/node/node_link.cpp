@@ -9,9 +9,10 @@
 
 namespace mocap::node {
 
-Expected<std::shared_ptr<NodeLink>> NodeLink::create(std::uint32_t domain_id, double wait_s) {
+Expected<std::shared_ptr<NodeLink>> NodeLink::create(std::uint32_t domain_id, double wait_s,
+                                                     bool realtime) {
   std::shared_ptr<NodeLink> l(new NodeLink());
-  auto d = NodeDomain::open(domain_id, "mocap run: nodes");
+  auto d = NodeDomain::open(domain_id, "mocap run: nodes", realtime);
   if (!d) return d.error();
   l->domain_ = std::move(d).value();
   auto r = l->domain_.reader(l->domain_.blob_topic(), "mocap run: mocap/blobs");
@@ -20,14 +21,11 @@ Expected<std::shared_ptr<NodeLink>> NodeLink::create(std::uint32_t domain_id, do
   auto w = l->domain_.writer(l->domain_.trigger_topic(), "mocap run: mocap/trigger");
   if (!w) return w.error();
   l->writer_ = *w;
-  l->waitset_ = dds_create_waitset(l->domain_.participant());
-  const dds_entity_t cond = dds_create_readcondition(l->reader_, DDS_ANY_STATE);
-  if (l->waitset_ < 0 || cond < 0 || dds_waitset_attach(l->waitset_, cond, 0) < 0)
-    return make_error("mocap run", "mocap/blobs", "cannot create the DDS waitset");
   auto ring = rt::SpscRing<std::uint64_t>::create(1024);
   if (!ring) return ring.error();
   l->triggers_ = std::make_unique<rt::SpscRing<std::uint64_t>>(std::move(ring).value());
   l->wait_s_ = wait_s;
+  l->realtime_ = realtime;
   return l;
 }
 
@@ -68,16 +66,28 @@ Expected<void> NodeLink::start() {
   stop_.store(false, std::memory_order_relaxed);  // no thread runs yet
   next_trigger_ = 0;
   received_end_.store(0, std::memory_order_relaxed);  // no thread runs yet
-  auto a = rt::start_thread(rt::ThreadSpec{"mocap-nrecv", -1, 0}, [this] { receive_loop(); });
-  if (!a) return a.error();
-  receive_thread_ = std::move(a).value();
-  auto b = rt::start_thread(rt::ThreadSpec{"mocap-ntrig", -1, 0}, [this] { trigger_loop(); });
+  const int priority = realtime_ ? kDdsFifoPriority : 0;
+  auto b =
+      rt::start_thread(rt::ThreadSpec{"mocap-ntrig", -1, priority}, [this] { trigger_loop(); });
   if (!b) return b.error();
   trigger_thread_ = std::move(b).value();
+  // The messages are taken where Cyclone delivers them (its receive thread): no hop.
+  dds_listener_t* l = dds_create_listener(this);
+  dds_lset_data_available(l, &NodeLink::on_data);
+  const dds_return_t rc = dds_set_listener(reader_, l);
+  dds_delete_listener(l);
+  if (rc < 0) {
+    users_ = 1;
+    stop();
+    return make_error("mocap run", "mocap/blobs", "cannot set the DDS listener");
+  }
+  notice_.clear();
   if (!wait_for_nodes(wait_s_)) {
     notice_ = "not every node was discovered within " + std::to_string(wait_s_) +
               " s: their cameras count as missing until they appear";
   }
+  if (!trigger_thread_.setup().note.empty())
+    notice_ += (notice_.empty() ? "" : "; ") + trigger_thread_.setup().note;
   return {};
 }
 
@@ -104,7 +114,8 @@ void NodeLink::stop() noexcept {
   // release: the threads' acquire loads see the stop.
   stop_.store(true, std::memory_order_release);
   trigger_bell_.ring();
-  if (receive_thread_.joinable()) receive_thread_.join();
+  // Returns once a listener call in progress has returned; none is made after.
+  (void)dds_set_listener(reader_, nullptr);
   if (trigger_thread_.joinable()) trigger_thread_.join();
 }
 
@@ -128,21 +139,22 @@ void NodeLink::trigger_loop() noexcept {
   }
 }
 
-void NodeLink::receive_loop() noexcept {
+void NodeLink::on_data(dds_entity_t reader, void* self) noexcept {
+  static_cast<NodeLink*>(self)->take_all(reader);
+}
+
+void NodeLink::take_all(dds_entity_t reader) noexcept {
   constexpr int kBatch = 16;
   void* samples[kBatch] = {};
   dds_sample_info_t infos[kBatch];
-  while (!stop_.load(std::memory_order_acquire)) {
-    (void)dds_waitset_wait(waitset_, nullptr, 0, DDS_MSECS(20));
-    for (;;) {
-      const dds_return_t n = dds_take(reader_, samples, infos, kBatch, kBatch);
-      if (n <= 0) break;
-      for (dds_return_t i = 0; i < n; ++i) {
-        if (infos[i].valid_data) on_sample(*static_cast<const mocap_node_BlobFrame*>(samples[i]));
-      }
-      (void)dds_return_loan(reader_, samples, n);
-      samples[0] = nullptr;  // the next take loans again
+  for (;;) {
+    const dds_return_t n = dds_take(reader, samples, infos, kBatch, kBatch);
+    if (n <= 0) break;
+    for (dds_return_t i = 0; i < n; ++i) {
+      if (infos[i].valid_data) on_sample(*static_cast<const mocap_node_BlobFrame*>(samples[i]));
     }
+    (void)dds_return_loan(reader, samples, n);
+    samples[0] = nullptr;  // the next take loans again
   }
 }
 

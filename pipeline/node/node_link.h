@@ -1,12 +1,14 @@
 // Design: the central tracker's side of the camera nodes (issue 29): one NodeLink per
 // `mocap run` (shared by its NodeCameras, node_camera.h) holds the DDS participant and
-//   - the receiver thread (`mocap-nrecv`, not real-time): takes mocap/blobs samples,
-//     finds the camera by (node, camera) name, checks and decodes the message
-//     (node_wire.h: malformed and oversized messages are counted per node and dropped)
-//     into a slot of that camera's inbox (rt::SlotPool, receiver -> capture thread;
-//     inbox full: counted, dropped), estimates the node's clock offset and rings the
-//     inbox doorbell;
-//   - the trigger thread (`mocap-ntrig`): writes mocap/trigger for every central trigger
+//   - the mocap/blobs listener, the receiver (called by Cyclone where it delivers a
+//     message: its receive thread, SCHED_FIFO kDdsFifoPriority when realtime, node_dds.h;
+//     no thread hop; its calls never overlap): takes the samples, finds the camera by
+//     (node, camera) name, checks and decodes the message (node_wire.h: malformed and
+//     oversized messages are counted per node and dropped) into a slot of that camera's
+//     inbox (rt::SlotPool, receiver -> capture thread; inbox full: counted, dropped),
+//     estimates the node's clock offset and rings the inbox doorbell;
+//   - the trigger thread (`mocap-ntrig`, SCHED_FIFO kDdsFifoPriority when realtime): writes
+//   mocap/trigger for every central trigger
 //     the capture thread posts (trigger(): an SPSC ring, never DDS on the capture thread).
 // Clock offset per node (CLOCK_REALTIME, node minus central), NTP-style from a trigger's
 // round trip: t0 central sent, t1 node received, t2 node sent, t3 central received:
@@ -44,13 +46,15 @@ struct NodeStats {
   rt::Counter messages, malformed, oversized;
   std::atomic<std::int64_t> offset_ns{0};                // node minus central CLOCK_REALTIME
   std::atomic<std::int64_t> round_trip_ns{-1};           // of that estimate; -1: one-way / none
-  std::int64_t window_best_rtt = -1, window_offset = 0;  // receiver thread
+  std::int64_t window_best_rtt = -1, window_offset = 0;  // the receiver
   int window_count = 0;
 };
 
 class NodeLink {
  public:
-  static Expected<std::shared_ptr<NodeLink>> create(std::uint32_t domain_id, double wait_s);
+  // realtime: its threads and Cyclone's receive thread at SCHED_FIFO kDdsFifoPriority.
+  static Expected<std::shared_ptr<NodeLink>> create(std::uint32_t domain_id, double wait_s,
+                                                    bool realtime);
   ~NodeLink();
 
   // Setup (before start): camera `camera` of node `node`; its inbox holds `slots`
@@ -60,8 +64,10 @@ class NodeLink {
   rt::SlotPool<Received>& inbox(int k) noexcept { return *inboxes_[static_cast<std::size_t>(k)]; }
   pipeline::Doorbell& bell() noexcept { return bell_; }
 
-  // Reference-counted by the cameras' start()/stop(): the first start starts the threads
-  // and waits for the nodes; one line on nodes not seen goes to notice().
+  // Reference-counted by the cameras' start()/stop(): the first start starts the trigger
+  // thread and the receiver and waits for the nodes; one line on nodes not seen (and on
+  // what of realtime was not applied) goes to notice(). The last stop returns once no
+  // receiver call runs.
   Expected<void> start();
   void stop() noexcept;
   const std::string& notice() const noexcept { return notice_; }
@@ -91,15 +97,18 @@ class NodeLink {
 
  private:
   NodeLink() = default;
-  void receive_loop() noexcept;
+  // The mocap/blobs listener (Cyclone's receive thread; its calls never overlap).
+  static void on_data(dds_entity_t reader, void* self) noexcept;
+  void take_all(dds_entity_t reader) noexcept;
   void trigger_loop() noexcept;
   void on_sample(const mocap_node_BlobFrame& s) noexcept;
   void estimate_offset(NodeStats& n, const WireHeader& h, std::int64_t t3) noexcept;
   bool wait_for_nodes(double wait_s) noexcept;
 
   NodeDomain domain_;
-  dds_entity_t reader_ = 0, writer_ = 0, waitset_ = 0;
+  dds_entity_t reader_ = 0, writer_ = 0;
   double wait_s_ = 10.0;
+  bool realtime_ = false;
   struct Camera {
     std::string node, camera;
     int node_index = 0;
@@ -108,14 +117,14 @@ class NodeLink {
   std::vector<std::unique_ptr<NodeStats>> nodes_;
   std::vector<std::unique_ptr<rt::SlotPool<Received>>> inboxes_;
   std::vector<std::unique_ptr<rt::Counter>> full_;
-  std::vector<std::int64_t> spare_;  // receiver thread: an acquired, unpublished slot or -1
+  std::vector<std::int64_t> spare_;  // receiver: an acquired, unpublished slot or -1
   std::unique_ptr<rt::SpscRing<std::uint64_t>> triggers_;
   std::uint64_t next_trigger_ = 0;  // capture thread: the lowest number not yet posted
   pipeline::Doorbell bell_, trigger_bell_;
   std::atomic<bool> stop_{false};
-  std::atomic<std::uint64_t> received_end_{0};  // receiver thread writes
+  std::atomic<std::uint64_t> received_end_{0};  // the receiver writes
   int users_ = 0;                               // started cameras (setup thread)
-  rt::RtThread receive_thread_, trigger_thread_;
+  rt::RtThread trigger_thread_;
   rt::Counter unknown_, triggers_sent_;
   LatencyHistogram transit_;
   LatencyHistogram trigger_leg_;  // central trigger written -> node received it

@@ -7,12 +7,12 @@ namespace mocap::node {
 
 Expected<std::unique_ptr<NodeSender>> NodeSender::create(std::uint32_t domain_id,
                                                          const std::vector<bool>& central,
-                                                         int queue_depth) {
+                                                         int queue_depth, bool realtime) {
   const int n = static_cast<int>(central.size());
   if (n < 1 || n > kMaxNodeCameras)
     return make_error("mocap node", "cameras", "1.." + std::to_string(kMaxNodeCameras));
   std::unique_ptr<NodeSender> s(new NodeSender());
-  auto d = NodeDomain::open(domain_id, "mocap node");
+  auto d = NodeDomain::open(domain_id, "mocap node", realtime);
   if (!d) return d.error();
   s->domain_ = std::move(d).value();
   auto w = s->domain_.writer(s->domain_.blob_topic(), "mocap node: mocap/blobs");
@@ -21,11 +21,8 @@ Expected<std::unique_ptr<NodeSender>> NodeSender::create(std::uint32_t domain_id
   auto r = s->domain_.reader(s->domain_.trigger_topic(), "mocap node: mocap/trigger");
   if (!r) return r.error();
   s->trigger_reader_ = *r;
-  s->waitset_ = dds_create_waitset(s->domain_.participant());
-  const dds_entity_t cond = dds_create_readcondition(s->trigger_reader_, DDS_ANY_STATE);
-  if (s->waitset_ < 0 || cond < 0 || dds_waitset_attach(s->waitset_, cond, 0) < 0)
-    return make_error("mocap node", "mocap/trigger", "cannot create the DDS waitset");
   s->central_ = central;
+  s->realtime_ = realtime;
   s->trigger_bells_ = std::make_unique<pipeline::Doorbell[]>(static_cast<std::size_t>(n));
   for (int c = 0; c < n; ++c) {
     auto q = rt::DropOldestQueue<WireFrame>::create(queue_depth);
@@ -42,15 +39,21 @@ NodeSender::~NodeSender() { stop(false); }
 
 Expected<void> NodeSender::start() {
   stop_.store(false, std::memory_order_relaxed);  // no thread runs yet
-  auto a = rt::start_thread(rt::ThreadSpec{"mocap-nsend", -1, 0}, [this] { send_loop(); });
+  notes_.clear();
+  const int priority = realtime_ ? kDdsFifoPriority : 0;
+  auto a = rt::start_thread(rt::ThreadSpec{"mocap-nsend", -1, priority}, [this] { send_loop(); });
   if (!a) return a.error();
   send_thread_ = std::move(a).value();
-  auto b = rt::start_thread(rt::ThreadSpec{"mocap-ntrig", -1, 0}, [this] { trigger_loop(); });
-  if (!b) {
+  if (!send_thread_.setup().note.empty()) notes_.push_back(send_thread_.setup().note);
+  // The triggers are taken where Cyclone delivers them (its receive thread): no hop.
+  dds_listener_t* l = dds_create_listener(this);
+  dds_lset_data_available(l, &NodeSender::on_triggers);
+  const dds_return_t rc = dds_set_listener(trigger_reader_, l);
+  dds_delete_listener(l);
+  if (rc < 0) {
     stop(false);
-    return b.error();
+    return make_error("mocap node", "mocap/trigger", "cannot set the DDS listener");
   }
-  trigger_thread_ = std::move(b).value();
   return {};
 }
 
@@ -59,7 +62,8 @@ void NodeSender::stop(bool flush) noexcept {
   stop_.store(true, std::memory_order_release);
   bell_.ring();
   if (send_thread_.joinable()) send_thread_.join();
-  if (trigger_thread_.joinable()) trigger_thread_.join();
+  // Returns once a listener call in progress has returned; none is made after.
+  if (trigger_reader_ > 0) (void)dds_set_listener(trigger_reader_, nullptr);
   if (flush && writer_ > 0) {
     while (send_pending()) {
     }
@@ -104,30 +108,34 @@ void NodeSender::send_loop() noexcept {
   }
 }
 
-void NodeSender::trigger_loop() noexcept {
+void NodeSender::on_triggers(dds_entity_t reader, void* self) noexcept {
+  static_cast<NodeSender*>(self)->take_triggers(reader);
+}
+
+void NodeSender::take_triggers(dds_entity_t reader) noexcept {
   constexpr int kBatch = 32;
   void* samples[kBatch] = {};
   dds_sample_info_t infos[kBatch];
-  while (!stop_.load(std::memory_order_acquire)) {
-    (void)dds_waitset_wait(waitset_, nullptr, 0, DDS_MSECS(20));
-    for (;;) {
-      const dds_return_t n = dds_take(trigger_reader_, samples, infos, kBatch, kBatch);
-      if (n <= 0) break;
-      const std::int64_t now = realtime_ns();
-      for (dds_return_t i = 0; i < n; ++i) {
-        if (!infos[i].valid_data) continue;
-        const auto* t = static_cast<const mocap_node_Trigger*>(samples[i]);
-        triggers_in_.add();
-        for (std::size_t c = 0; c < central_.size(); ++c) {
-          if (!central_[c]) continue;
-          if (!triggers_[c]->try_push(TriggerStamp{t->trigger_number, t->sent_ns, now}))
-            triggers_dropped_.add();
-          trigger_bells_[c].ring();
-        }
+  for (;;) {
+    const dds_return_t n = dds_take(reader, samples, infos, kBatch, kBatch);
+    if (n <= 0) break;
+    const std::int64_t now = realtime_ns();
+    for (dds_return_t i = 0; i < n; ++i) {
+      if (!infos[i].valid_data) continue;
+      const auto* t = static_cast<const mocap_node_Trigger*>(samples[i]);
+      triggers_in_.add();
+      for (std::size_t c = 0; c < central_.size(); ++c) {
+        if (central_[c] &&
+            !triggers_[c]->try_push(TriggerStamp{t->trigger_number, t->sent_ns, now}))
+          triggers_dropped_.add();
       }
-      (void)dds_return_loan(trigger_reader_, samples, n);
-      samples[0] = nullptr;  // the next take loans again
     }
+    (void)dds_return_loan(reader, samples, n);
+    samples[0] = nullptr;  // the next take loans again
+    // Every camera's trigger first, then the wake-ups: a woken camera thread never delays
+    // the next camera's trigger.
+    for (std::size_t c = 0; c < central_.size(); ++c)
+      if (central_[c]) trigger_bells_[c].ring();
   }
 }
 

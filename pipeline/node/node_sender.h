@@ -1,12 +1,14 @@
-// Design: the DDS side of `mocap node` (issue 29), two non-real-time threads between the
-// node's camera threads (node_runner.h) and the network:
-//   - sender (`mocap-nsend`): takes every camera's messages from its bounded drop-oldest
-//     queue (rt::DropOldestQueue<WireFrame>, one per camera: one producer each; drops are
-//     counted and reported in the camera's health), stamps sent_ns and writes them to
-//     mocap/blobs. The camera threads never touch DDS (it locks and allocates).
-//   - trigger reader (`mocap-ntrig`): takes mocap/trigger samples and hands each trigger
+// Design: the DDS side of `mocap node` (issue 29), between the node's camera threads
+// (node_runner.h) and the network:
+//   - the sender thread (`mocap-nsend`, SCHED_FIFO kDdsFifoPriority when realtime): takes
+//     every camera's messages from its bounded drop-oldest queue (rt::DropOldestQueue<
+//     WireFrame>, one per camera: one producer each; drops are counted and reported in the
+//     camera's health), stamps sent_ns and writes them to mocap/blobs. The camera threads
+//     never touch DDS (it locks and allocates).
+//   - the mocap/trigger listener, called by Cyclone where it delivers a trigger (its
+//     receive thread, real-time too: node_dds.h), so no thread hop: hands each trigger
 //     (number, central send time, node receive time) to every camera with `trigger:
-//     central` through its SPSC ring, then rings that camera's doorbell.
+//     central` through its SPSC ring, then rings the cameras' doorbells (after every push).
 // Setup allocates (queues of depth x 139 KiB per camera); the camera-thread side
 // (queue push, trigger ring pop, doorbells) is noexcept, lock-free and allocation-free.
 #pragma once
@@ -35,12 +37,14 @@ struct TriggerStamp {
 class NodeSender {
  public:
   // central[c]: camera c follows the central triggers. queue_depth: messages per camera.
+  // realtime: both threads and Cyclone's receive thread at SCHED_FIFO kDdsFifoPriority.
   static Expected<std::unique_ptr<NodeSender>> create(std::uint32_t domain_id,
                                                       const std::vector<bool>& central,
-                                                      int queue_depth);
+                                                      int queue_depth, bool realtime);
   ~NodeSender();
 
-  Expected<void> start();
+  Expected<void> start();  // notes(): what of realtime was not applied
+  const std::vector<std::string>& notes() const noexcept { return notes_; }
   // Stops both threads; first sends what is queued and waits (bounded) for the readers'
   // acknowledgements when `flush`.
   void stop(bool flush) noexcept;
@@ -64,17 +68,21 @@ class NodeSender {
   static std::size_t idx(int c) noexcept { return static_cast<std::size_t>(c); }
   void send_loop() noexcept;
   bool send_pending() noexcept;  // true when something was written
-  void trigger_loop() noexcept;
+  // The mocap/trigger listener (Cyclone's receive thread; its calls never overlap).
+  static void on_triggers(dds_entity_t reader, void* self) noexcept;
+  void take_triggers(dds_entity_t reader) noexcept;
 
   NodeDomain domain_;
-  dds_entity_t writer_ = 0, trigger_reader_ = 0, waitset_ = 0;
+  dds_entity_t writer_ = 0, trigger_reader_ = 0;
   std::vector<bool> central_;
+  bool realtime_ = false;
+  std::vector<std::string> notes_;
   std::vector<std::unique_ptr<rt::DropOldestQueue<WireFrame>>> queues_;
   std::vector<std::unique_ptr<rt::SpscRing<TriggerStamp>>> triggers_;
   std::unique_ptr<pipeline::Doorbell[]> trigger_bells_;
   pipeline::Doorbell bell_;
   std::atomic<bool> stop_{false};
-  rt::RtThread send_thread_, trigger_thread_;
+  rt::RtThread send_thread_;
   rt::Counter sent_, write_errors_, triggers_in_, triggers_dropped_;
 };
 

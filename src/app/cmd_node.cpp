@@ -177,7 +177,7 @@ int run_node(const NodeArgs& a) {
     central.push_back(s.central_trigger);
     specs.push_back(spec);
   }
-  auto sender = node::NodeSender::create(cfg->node.domain_id, central, 8);
+  auto sender = node::NodeSender::create(cfg->node.domain_id, central, 8, cfg->pipeline.realtime);
   if (!sender) return fail(sender.error().message);
   node::NodeOptions opt;
   opt.node_name = name;
@@ -194,6 +194,8 @@ int run_node(const NodeArgs& a) {
   if (auto r = (*sender)->start(); !r) return fail(r.error().message);
   if (auto r = (*runner)->start(); !r) return fail(r.error().message);
   for (const std::string& n : (*runner)->notes())
+    std::fprintf(stderr, "mocap node: note: %s\n", n.c_str());
+  for (const std::string& n : (*sender)->notes())
     std::fprintf(stderr, "mocap node: note: %s\n", n.c_str());
   std::fprintf(stderr, "mocap node: %s publishing %zu cameras on DDS domain %u\n", name.c_str(),
                specs.size(), cfg->node.domain_id);

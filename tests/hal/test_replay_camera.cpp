@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <memory>
+#include <utility>
 
 #include "formats/pgm.h"
 #include "formats/rig_yaml.h"
@@ -165,6 +166,26 @@ TEST_F(ReplayFixture, SoftwareTriggerReleasesOneFrameEach) {
   ASSERT_EQ(cam->dequeue(f, 1000), CameraStatus::kOk);
   EXPECT_EQ(f.sequence, 1u);
   EXPECT_EQ(cam->dequeue(f, 0), CameraStatus::kTimeout);
+}
+
+// Software-triggered, a frame's latencies start at the trigger that released it (as a
+// live camera's exposure, and as a camera node's frame on the central), not at its
+// delivery: each origin lies between the clock reads around its own trigger.
+TEST_F(ReplayFixture, SoftwareTriggeredFramesStartTheirLatenciesAtTheirTrigger) {
+  auto cam = camera(0, ReplayPacing::kAsFastAsPossible, TriggerMode::kSoftware);
+  const std::int64_t t0 = monotonic_ns();
+  ASSERT_EQ(cam->trigger(), CameraStatus::kOk);
+  const std::int64_t t1 = monotonic_ns();
+  ASSERT_EQ(cam->trigger(), CameraStatus::kOk);
+  const std::int64_t t2 = monotonic_ns();
+  Frame f;
+  for (const auto& [from, to] : {std::pair{t0, t1}, std::pair{t1, t2}}) {
+    ASSERT_EQ(cam->dequeue(f, 1000), CameraStatus::kOk);
+    EXPECT_GE(latency_origin_ns(f), from);
+    EXPECT_LE(latency_origin_ns(f), to);
+    EXPECT_LE(f.delivered_ns, f.received_ns);
+    ASSERT_EQ(cam->release(f), CameraStatus::kOk);
+  }
 }
 
 // A camera node's `trigger: central` replay: seek() makes the named frame the next one

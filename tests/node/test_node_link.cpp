@@ -3,7 +3,8 @@
 // the test's own: frames delivered in trigger order with their blobs; a duplicate, a late,
 // a malformed, an oversized and an unknown camera's message counted and dropped; a silent
 // camera's frames delivered missing once another node answered, then the camera down and
-// back (reconnects); the end-of-stream message ends the camera's stream.
+// back (reconnects); the end-of-stream message ends the camera's stream. A domain created
+// for real time closes with its last participant.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -23,7 +24,9 @@ class NodeLinkTest : public ::testing::Test {
  protected:
   void SetUp() override {
     domain_ = 1 + static_cast<std::uint32_t>((::getpid() * 7) % 231);
-    auto link = NodeLink::create(domain_, 0.3);  // 2 nodes configured, 1 peer: short
+    // realtime: the link creates the domain (one SCHED_FIFO receive thread); the peer below
+    // joins it.
+    auto link = NodeLink::create(domain_, 0.3, true);  // 2 nodes configured, 1 peer: short
     ASSERT_TRUE(link) << link.error().message;
     link_ = std::move(link).value();
     for (const char* dev : {"n0/cam0", "n1/cam1"}) {
@@ -33,7 +36,7 @@ class NodeLinkTest : public ::testing::Test {
       ASSERT_TRUE((*cam)->configure(c));
       cams_.push_back(std::move(cam).value());
     }
-    auto d = NodeDomain::open(domain_, "test");
+    auto d = NodeDomain::open(domain_, "test", true);
     ASSERT_TRUE(d) << d.error().message;
     peer_ = std::move(d).value();
     auto w = peer_.writer(peer_.blob_topic(), "test");
@@ -188,11 +191,38 @@ TEST_F(NodeLinkTest, ASilentCameraGoesMissingThenDownThenComesBack) {
 }
 
 TEST(NodeCameraOpen, RejectsABadDevice) {
-  auto link = NodeLink::create(1 + static_cast<std::uint32_t>(::getpid() % 231), 0.0);
+  auto link = NodeLink::create(1 + static_cast<std::uint32_t>(::getpid() % 231), 0.0, false);
   ASSERT_TRUE(link);
   EXPECT_FALSE(NodeCamera::open(*link, "nocamera", 16, 100));
   EXPECT_FALSE(NodeCamera::open(*link, "a/b/c", 16, 100));
   EXPECT_FALSE(NodeCamera::open(*link, "a/b", 0, 100));
+}
+
+// A domain created for real time by one NodeDomain and joined by another outlives the
+// first one closed, and goes with the last (the domain can then be created anew).
+TEST(NodeDomainOpen, TheLastParticipantClosesTheDomainItCreated) {
+  const auto id = 1 + static_cast<std::uint32_t>((::getpid() * 3) % 231);
+  for (const bool creator_first : {true, false}) {
+    auto a = std::make_unique<NodeDomain>();
+    auto b = std::make_unique<NodeDomain>();
+    {
+      auto d = NodeDomain::open(id, "a", true);
+      ASSERT_TRUE(d) << d.error().message;
+      *a = std::move(d).value();
+      auto e = NodeDomain::open(id, "b", true);  // the domain exists: joined
+      ASSERT_TRUE(e) << e.error().message;
+      *b = std::move(e).value();
+    }
+    (creator_first ? a : b).reset();
+    const auto& left = creator_first ? b : a;
+    EXPECT_GT(dds_get_parent(left->participant()), 0);  // still alive
+    EXPECT_TRUE(left->writer(left->blob_topic(), "left"));
+    EXPECT_EQ(dds_create_domain(id, ""), DDS_RETCODE_PRECONDITION_NOT_MET);
+    (creator_first ? b : a).reset();
+    const dds_entity_t again = dds_create_domain(id, "");  // gone with the last one
+    EXPECT_GT(again, 0);
+    if (again > 0) dds_delete(again);
+  }
 }
 
 }  // namespace
