@@ -17,43 +17,56 @@ ParallelDetect::~ParallelDetect() {
   worker_.join();
 }
 
-void ParallelDetect::detect_share(int first_camera) noexcept {
-  for (int c = first_camera; c < proc_.camera_count(); c += 2) {
-    const auto uc = static_cast<std::size_t>(c);
+void ParallelDetect::detect_claimed(std::uint32_t gen) noexcept {
+  const auto n = static_cast<std::uint32_t>(proc_.camera_count());
+  std::uint64_t v = next_.load(std::memory_order_relaxed);
+  for (;;) {
+    if (static_cast<std::uint32_t>(v >> 32) != gen || static_cast<std::uint32_t>(v) >= n) return;
+    // acquire on success: pairs with the caller's release store of this generation, so
+    // views_ and out_ are this frame's; relaxed on failure (v is reloaded and re-checked).
+    if (!next_.compare_exchange_weak(v, v + 1, std::memory_order_acquire,
+                                     std::memory_order_relaxed))
+      continue;
+    const auto uc = static_cast<std::size_t>(static_cast<std::uint32_t>(v));
     const ImageView* view = uc < views_.size() ? views_[uc] : nullptr;
     out_->blobs[uc].clear();
     out_->camera_present[uc] = view != nullptr;
-    if (view != nullptr) proc_.detect_camera(c, *view, out_->blobs[uc]);
+    if (view != nullptr) proc_.detect_camera(static_cast<int>(uc), *view, out_->blobs[uc]);
+    // release: the caller's acquire load of completed_ sees this camera's blob list.
+    if (completed_.fetch_add(1, std::memory_order_release) + 1 == n) completed_.notify_one();
+    v = next_.load(std::memory_order_relaxed);
   }
 }
 
 void ParallelDetect::run() noexcept {
   std::uint32_t seen = 0;
   for (;;) {
-    // acquire: pairs with the caller's release increment, so views_ and out_ (and
-    // stop_) written before it are visible here.
+    // acquire: pairs with the caller's (or the destructor's) release store, so stop_ is
+    // seen; the frame itself is published through next_ (detect_claimed).
     posted_.wait(seen, std::memory_order_acquire);
     seen = posted_.load(std::memory_order_acquire);
     if (stop_.load(std::memory_order_acquire)) return;
-    detect_share(1);
-    // release: the caller's acquire load of done_ sees the odd cameras' blob lists.
-    done_.store(seen, std::memory_order_release);
-    done_.notify_one();
+    detect_claimed(seen);
   }
 }
 
 void ParallelDetect::detect(std::span<const ImageView* const> views, FrameOutput& out) noexcept {
   const std::int64_t t0 = monotonic_ns();
+  const auto n = static_cast<std::uint32_t>(proc_.camera_count());
+  // Every claim of the previous frame completed before it returned: nothing reads these.
   views_ = views;
   out_ = &out;
-  // release: publishes views_ and out_ to the worker (see run()).
-  const std::uint32_t frame = posted_.fetch_add(1, std::memory_order_release) + 1;
+  completed_.store(0, std::memory_order_relaxed);
+  const std::uint32_t gen = posted_.load(std::memory_order_relaxed) + 1;
+  // release: publishes views_, out_ and the reset count with the generation's counter.
+  next_.store(static_cast<std::uint64_t>(gen) << 32, std::memory_order_release);
+  posted_.store(gen, std::memory_order_release);
   posted_.notify_one();
-  detect_share(0);
-  // acquire: pairs with the worker's release store; its blob lists are complete.
-  for (std::uint32_t d = done_.load(std::memory_order_acquire); d != frame;
-       d = done_.load(std::memory_order_acquire))
-    done_.wait(d, std::memory_order_acquire);
+  detect_claimed(gen);
+  // acquire: pairs with each claim's release increment; every blob list is complete.
+  for (std::uint32_t k = completed_.load(std::memory_order_acquire); k != n;
+       k = completed_.load(std::memory_order_acquire))
+    completed_.wait(k, std::memory_order_acquire);
   out.times.detect = monotonic_ns() - t0;
 }
 

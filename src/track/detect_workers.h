@@ -1,14 +1,20 @@
 // Design: the offline tracker's detection on two cores, as the live pipeline detects
 // (one detect stage per camera, spread over the cores; pipeline/stage_table.h). A
-// persistent worker thread detects the odd cameras of a frame while the calling thread
-// detects the even ones; the frame's other stages (correspondence, triangulation,
+// persistent worker thread and the calling thread take the cameras of a frame one at a
+// time from a shared counter, so a worker that wakes late (a futex wake-up on a loaded
+// machine can take a millisecond) only leaves more cameras to the caller instead of
+// delaying the frame; the frame's other stages (correspondence, triangulation,
 // identification, angles) then run on the calling thread. The output is exactly
 // FrameProcessor::process's: every camera has its own detector and blob list, and
 // detect_camera() is thread-safe between different cameras.
-// One handshake per frame through two 32-bit counters (C++20 atomic wait/notify: a futex
-// on int-sized atomics, no lock; no allocation after construction; the counters wrap and
-// are only compared for equality). Timings are wall-clock, as in process(): `detect` is
-// the time until every camera of the frame was detected.
+// Per frame: the caller publishes the frame and a generation-tagged camera counter
+// (next_: generation << 32 | next camera) and rings posted_ (C++20 atomic wait/notify: a
+// futex on int-sized atomics, no lock); each thread claims a camera by compare-exchange
+// of next_ (a stale worker sees another generation or no camera left and claims nothing);
+// completed_ counts the cameras detected, and the caller returns when it reaches the
+// camera count, so the frame's views stay valid for every claim. No allocation after
+// construction. Timings are wall-clock, as in process(): `detect` is the time until
+// every camera of the frame was detected.
 #pragma once
 
 #include <atomic>
@@ -36,16 +42,18 @@ class ParallelDetect {
                FrameOutput& out) noexcept;
 
  private:
-  void detect_share(int first_camera) noexcept;  // cameras first, first + 2, ...
+  // Claims and detects cameras of generation `gen` until none is left.
+  void detect_claimed(std::uint32_t gen) noexcept;
   void run() noexcept;
 
   FrameProcessor& proc_;
-  // The frame in hand: written by the caller before posted_'s release increment, read
-  // by the worker after its acquire load.
+  // The frame in hand: written by the caller before next_'s release store, read by a
+  // thread after its acquire compare-exchange of next_ claimed one of its cameras.
   std::span<const ImageView* const> views_;
   FrameOutput* out_ = nullptr;
-  std::atomic<std::uint32_t> posted_{0};  // frames handed to the worker
-  std::atomic<std::uint32_t> done_{0};    // frames whose odd cameras the worker detected
+  std::atomic<std::uint64_t> next_{0};       // generation << 32 | next camera to claim
+  std::atomic<std::uint32_t> posted_{0};     // the generation posted (the worker's doorbell)
+  std::atomic<std::uint32_t> completed_{0};  // cameras of this generation detected
   std::atomic<bool> stop_{false};
   std::thread worker_;
 };
