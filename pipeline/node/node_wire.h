@@ -17,6 +17,7 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "core/camera_set.h"
 #include "detect/blob.h"
 
 namespace mocap::node {
@@ -26,7 +27,6 @@ inline constexpr std::size_t kNameBytes = 64;  // string<63> + NUL (node_msgs.id
 inline constexpr std::size_t kBlobRecordBytes = 68;
 inline constexpr std::uint32_t kMaxBlobsPerMessage = 2048;  // node_msgs.idl's bound / 68
 inline constexpr std::size_t kMaxBlobBytes = kMaxBlobsPerMessage * kBlobRecordBytes;
-inline constexpr int kMaxNodeCameras = 8;  // cameras one node publishes
 
 enum WireFlag : std::uint16_t {
   kWireMissing = 1u << 0,      // the camera had no image for this frame (replay)
