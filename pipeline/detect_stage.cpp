@@ -43,7 +43,7 @@ void DetectStage::run() noexcept {
   context_.loop_start(id);
   Doorbell& bell = context_.bell(id);
   Doorbell& next = context_.bell(StageId::kIdentify);
-  const bool every_frame = context_.options().detect_every_frame;
+  const bool every_frame = context_.options().every_frame;
   BlobTap* const tap = context_.options().blob_tap;
   while (!context_.stopping()) {
     const std::uint32_t seen = bell.snapshot();

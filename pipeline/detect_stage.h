@@ -9,8 +9,8 @@
 // its node detected and no image: they are copied into the blob slot, not detected.
 // Drop policy: it works on the NEWEST frame and returns the older ones (detect#_skipped);
 // when identify holds every blob slot the frame is dropped (detect#_no_slot). With
-// options.detect_every_frame (`mocap record --blobs`) it detects every frame in order
-// (no skips; a full input ring drops at the capture). options.blob_tap, if set, gets each
+// options.every_frame (`mocap record --blobs`, `pipeline.every_frame`) it detects every frame in
+// order (no skips; a full input ring drops at the capture). options.blob_tap, if set, gets each
 // detected frame's blob list on this thread (BlobTap, pipeline_options.h).
 // Its counters, the detector library's mirrored counters (detect_cam#_*) and its two
 // histograms (latency from the trigger, own work) have this thread as only writer.

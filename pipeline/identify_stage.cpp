@@ -79,11 +79,14 @@ void IdentifyStage::run() noexcept {
     context_.retire(sequence);
   };
   const bool by_time = context_.options().pair_by == PairBy::kTimestamp;
+  const bool every_frame = context_.options().every_frame;
   bool have_set = false;
   hal::FramePair set{};
   auto take = [&](const hal::FramePair& p) {
     count_unpaired(sequence_of(p));
-    if (have_set) {  // drop-oldest: a newer set is complete
+    if (have_set && every_frame) {  // in order: the older set first
+      process(set);
+    } else if (have_set) {  // drop-oldest: a newer set is complete
       counters_.skipped.add();
       const std::uint64_t dropped = sequence_of(set);
       release_set(set);

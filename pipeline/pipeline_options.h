@@ -96,10 +96,12 @@ struct PipelineOptions {
   StageHooks* hooks = nullptr;
   FrameTap* tap = nullptr;      // `mocap record`: every delivered frame, capture thread
   BlobTap* blob_tap = nullptr;  // `mocap record --blobs`: every detected frame, detect threads
-  // true (`mocap record --blobs`): each detect stage detects every frame in order instead
-  // of the newest (no detect#_skipped; a detector that falls behind fills its input ring
-  // and the capture drops there, counted as ring_full).
-  bool detect_every_frame = false;
+  // true (`mocap record --blobs`, `pipeline.every_frame`): every stage works on every
+  // frame in order instead of the newest (no detect#_skipped, identify_skipped or
+  // publish_skipped): a stall shorter than the rings' depth delays frames and loses none.
+  // A stage that falls behind for longer fills its input ring and the producer drops there
+  // (capture_dropped_cam#, detect#_no_slot, identify_no_slot).
+  bool every_frame = false;
 };
 
 }  // namespace mocap::pipeline

@@ -26,10 +26,11 @@ void PublishStage::run() noexcept {
   Doorbell& bell = context_.bell(StageId::kPublish);
   std::uint64_t skipped_seen = 0;
   std::int64_t prev_publish_ns = 0;
+  const bool every_frame = context_.options().every_frame;
   while (!context_.stopping()) {
     const std::uint32_t seen = bell.snapshot();
     rt::SlotHandle h;
-    if (!input_.pop_latest(h)) {
+    if (!(every_frame ? input_.pop(h) : input_.pop_latest(h))) {
       bell.wait(seen, kIdleWaitNs);
       continue;
     }

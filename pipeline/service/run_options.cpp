@@ -15,6 +15,7 @@ pipeline::PipelineOptions pipeline_options(const config::RunConfig& cfg) {
   pipeline::PipelineOptions o;
   o.trigger_rate_hz = cfg.pipeline.trigger_rate_hz;
   o.pacing = cfg.pipeline.pacing;
+  o.every_frame = cfg.pipeline.every_frame;
   o.realtime = cfg.pipeline.realtime;
   o.lock_memory = cfg.pipeline.lock_memory;
   o.cpu_latency_us = cfg.pipeline.cpu_latency_us;

@@ -177,7 +177,7 @@ int record(const RecordArgs& a) {
   opt.tap = recorder->get();
   if (a.blobs) {  // the blob lists of the pipeline's detect stages, every frame in order
     opt.blob_tap = recorder->get();
-    opt.detect_every_frame = true;
+    opt.every_frame = true;
   }
   opt.max_frames = trigger_limit;
   auto pipe = pipeline::Pipeline::create((*live)->take_processor(), (*live)->cameras(), {}, opt);
@@ -251,7 +251,7 @@ int record(const RecordArgs& a) {
         (c > 0 ? ", cam" : "cam") + std::to_string(c) + " " + std::to_string(k.dropped[c]);
   if (a.blobs) {
     // Frames that never reached the recorder: the detect stage had no blob slot, or its
-    // input ring was full (detect_every_frame: a detector behind drops at the capture).
+    // input ring was full (every_frame: a detector behind drops at the capture).
     std::uint64_t not_detected = 0;
     for (const auto& [name, value] : (*pipe)->stats().counters)
       if ((name.rfind("detect", 0) == 0 && name.find("_no_slot") != std::string::npos) ||

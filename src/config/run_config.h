@@ -74,9 +74,10 @@ struct PipelineSettings {
   PairBy pair_by = PairBy::kSequence;  // pipeline.pair_by
   int pair_tolerance_us = 1000;        // pipeline.pair_tolerance_us (pair_by: timestamp)
   TriggerPacing pacing = TriggerPacing::kPeriodic;
-  bool realtime = true;     // CPU pinning + SCHED_FIFO (falls back when not permitted)
-  bool lock_memory = true;  // mlockall (falls back when not permitted)
-  int cpu_latency_us = 0;   // PM QoS CPU latency while running; -1: none (rt/cpu_latency.h)
+  bool realtime = true;      // CPU pinning + SCHED_FIFO (falls back when not permitted)
+  bool every_frame = false;  // every stage works on every frame in order (not the newest)
+  bool lock_memory = true;   // mlockall (falls back when not permitted)
+  int cpu_latency_us = 0;    // PM QoS CPU latency while running; -1: none (rt/cpu_latency.h)
   int dequeue_timeout_ms = 20;
   std::array<StageSettings, kStageCount> stages{};
   std::array<StageSettings, kMaxCameras> detect_camera{};  // stages.detect<k>

@@ -161,6 +161,8 @@ const ErrorCase kCases[] = {
      "pipeline.pacing: expected periodic|lockstep, got 'fast' (line 1)"},
     {"RealtimeNotABool", "pipeline: {realtime: yes}\n",
      "pipeline.realtime: expected true or false, got 'yes' (line 1)"},
+    {"EveryFrameNotABool", "pipeline: {every_frame: all}\n",
+     "pipeline.every_frame: expected true or false, got 'all' (line 1)"},
     {"CpuLatencyTooLow", "pipeline: {cpu_latency_us: -2}\n",
      "pipeline.cpu_latency_us: must be in [-1, 1000000], got -2 (line 1)"},
     {"DequeueTimeout", "pipeline: {dequeue_timeout_ms: 0}\n",

@@ -136,15 +136,16 @@ TEST(RunConfig, TwelveNodeCamerasLoadAndANodeTakesAtMostEight) {
 
 TEST(RunConfig, ThresholdsAndOutputsAreRead) {
   TempDir dir("cfg_thr");
-  write_file(dir.file("m.yaml"),
-             "outputs: {udp: ['10.0.0.2:9000', 'robot.local:7755'], iceoryx: false}\n"
-             "detection: {threshold_mode: fixed, threshold_dn: 60, background_dn: 10,\n"
-             "            roi: {x: 10, y: 20, width: 100, height: 50}, border: reject}\n"
-             "stereo: {epipolar_tolerance_px: 1.5, min_depth_mm: 200, max_depth_mm: 5000}\n"
-             "identification: {t_mm: 4, min_markers: 4, temporal: false}\n"
-             "pipeline: {pacing: lockstep, realtime: false, cpu_latency_us: 50,\n"
-             "           stages: {publish: {cpu: -1}}}\n"
-             "fault_injection: {stall_after_frames: 50}\n");
+  write_file(
+      dir.file("m.yaml"),
+      "outputs: {udp: ['10.0.0.2:9000', 'robot.local:7755'], iceoryx: false}\n"
+      "detection: {threshold_mode: fixed, threshold_dn: 60, background_dn: 10,\n"
+      "            roi: {x: 10, y: 20, width: 100, height: 50}, border: reject}\n"
+      "stereo: {epipolar_tolerance_px: 1.5, min_depth_mm: 200, max_depth_mm: 5000}\n"
+      "identification: {t_mm: 4, min_markers: 4, temporal: false}\n"
+      "pipeline: {pacing: lockstep, realtime: false, cpu_latency_us: 50, every_frame: true,\n"
+      "           stages: {publish: {cpu: -1}}}\n"
+      "fault_injection: {stall_after_frames: 50}\n");
   auto cfg = load_run_config(dir.file("m.yaml"));
   ASSERT_TRUE(cfg) << cfg.error().message;
   EXPECT_EQ(cfg->outputs.udp.size(), 2u);
@@ -158,6 +159,7 @@ TEST(RunConfig, ThresholdsAndOutputsAreRead) {
   EXPECT_FALSE(cfg->tracker.identify.temporal);
   EXPECT_EQ(cfg->pipeline.pacing, TriggerPacing::kLockstep);
   EXPECT_FALSE(cfg->pipeline.realtime);
+  EXPECT_TRUE(cfg->pipeline.every_frame);
   EXPECT_EQ(cfg->pipeline.cpu_latency_us, 50);
   EXPECT_EQ(*cfg->pipeline.stages[3].cpu, -1);
   EXPECT_EQ(cfg->faults.stall_after_frames, 50u);

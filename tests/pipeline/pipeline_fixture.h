@@ -83,17 +83,20 @@ struct SimRigFixture {
   }
 };
 
-// Stores up to `capacity` messages; optional sleep per publish (a slow transport).
+// Stores up to `capacity` messages; optional sleep per publish (a slow transport), on
+// every message or, with sleep_every = N, on every Nth (a transport that stalls now and
+// then).
 class RecordingSink final : public publish::OutputSink {
  public:
-  explicit RecordingSink(std::size_t capacity, int sleep_us = 0)
-      : messages_(capacity), sleep_us_(sleep_us) {}
+  explicit RecordingSink(std::size_t capacity, int sleep_us = 0, int sleep_every = 1)
+      : messages_(capacity), sleep_us_(sleep_us), sleep_every_(sleep_every) {}
   const char* name() const noexcept override { return "recording"; }
   publish::OutputCounters counters() const noexcept override { return {}; }
   bool publish(const publish::FrameResult& frame) noexcept override {
     const client::JointsMessage& m = frame.joints;
-    if (sleep_us_ > 0) std::this_thread::sleep_for(std::chrono::microseconds(sleep_us_));
     const std::size_t n = count_.load(std::memory_order_relaxed);  // single writer
+    if (sleep_us_ > 0 && n % static_cast<std::size_t>(sleep_every_) == 0)
+      std::this_thread::sleep_for(std::chrono::microseconds(sleep_us_));
     if (n >= messages_.size()) return false;
     messages_[n] = m;
     ResultSummary& r = results_[n];
@@ -122,6 +125,7 @@ class RecordingSink final : public publish::OutputSink {
   std::vector<ResultSummary> results_ = std::vector<ResultSummary>(messages_.size());
   std::atomic<std::size_t> count_{0};
   int sleep_us_ = 0;
+  int sleep_every_ = 1;
 };
 
 inline PipelineOptions test_options() {

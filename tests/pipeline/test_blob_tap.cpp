@@ -1,7 +1,7 @@
 // The pipeline's blob tap (`mocap record --blobs`, pipeline_options.h: BlobTap and
-// detect_every_frame) on the simulated stereo pair: each detect stage hands every frame
+// every_frame) on the simulated stereo pair: each detect stage hands every frame
 // it detected to the tap, in sequence order, with the blob list identification gets; with
-// detect_every_frame no frame is skipped for a newer one (detect#_skipped stays 0), so
+// every_frame no frame is skipped for a newer one (detect#_skipped stays 0), so
 // every frame a camera delivered reaches the tap unless counted as dropped at the capture
 // (ring full) or for want of a blob slot. Counts, never timing: the same under load and TSan.
 #include <gtest/gtest.h>
@@ -38,7 +38,7 @@ void run_with_tap(TriggerPacing pacing, double rate_hz) {
   opt.pacing = pacing;
   opt.trigger_rate_hz = rate_hz;
   opt.blob_tap = &tap;
-  opt.detect_every_frame = true;
+  opt.every_frame = true;
   auto p = Pipeline::create(rig.processor(), rig.cameras(), {}, opt);
   ASSERT_TRUE(p.ok()) << p.error().message;
   ASSERT_TRUE((*p)->start().ok());
