@@ -29,7 +29,7 @@ void PublishStage::run() noexcept {
   const bool every_frame = context_.options().every_frame;
   while (!context_.stopping()) {
     const std::uint32_t seen = bell.snapshot();
-    rt::SlotHandle h;
+    rt::SlotHandle h{};  // (set by either pop; GCC's -O1 cannot tell through the choice)
     if (!(every_frame ? input_.pop(h) : input_.pop_latest(h))) {
       bell.wait(seen, kIdleWaitNs);
       continue;
