@@ -51,11 +51,14 @@ void ParallelDetect::run() noexcept {
     const std::int64_t t0 = monotonic_ns();
     for (;;) {
       if (stop_.load(std::memory_order_acquire)) return;
-      // relaxed: only the generation is read here; detect_claimed's compare-exchange
-      // acquires the frame.
-      const auto gen = static_cast<std::uint32_t>(next_.load(std::memory_order_relaxed) >> 32);
+      // acquire: pairs with the caller's release store of the generation, so the bell the
+      // caller rang before it (detect()) is in the load of posted_ below.
+      const auto gen = static_cast<std::uint32_t>(next_.load(std::memory_order_acquire) >> 32);
       if (gen != taken) {
         taken = gen;
+        // This frame's bell is consumed: sleep until the next warm() or frame, instead of
+        // spinning through the frame's other stages.
+        seen = posted_.load(std::memory_order_relaxed);
         detect_claimed(gen);
         break;
       }
@@ -79,11 +82,12 @@ void ParallelDetect::detect(std::span<const ImageView* const> views, FrameOutput
   out_ = &out;
   completed_.store(0, std::memory_order_relaxed);
   const std::uint32_t gen = ++generation_;
-  // release: publishes views_, out_ and the reset count with the generation's counter.
-  next_.store(static_cast<std::uint64_t>(gen) << 32, std::memory_order_release);
-  // release: the bell; a worker spinning after warm() sees next_ without it.
+  // The bell before the frame: a worker that sees the generation (acquire) also sees the
+  // bell, so it does not wake again for this frame. release: pairs with the worker's wait.
   posted_.fetch_add(1, std::memory_order_release);
   posted_.notify_one();
+  // release: publishes views_, out_ and the reset count with the generation's counter.
+  next_.store(static_cast<std::uint64_t>(gen) << 32, std::memory_order_release);
   detect_claimed(gen);
   // acquire: pairs with each claim's release increment; every blob list is complete.
   // The worker's last camera is short: spin for it first, then sleep.

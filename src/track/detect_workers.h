@@ -7,9 +7,9 @@
 // identification, angles) then run on the calling thread. The output is exactly
 // FrameProcessor::process's: every camera has its own detector and blob list, and
 // detect_camera() is thread-safe between different cameras.
-// Per frame: the caller publishes the frame and a generation-tagged camera counter
-// (next_: generation << 32 | next camera) and rings posted_ (C++20 atomic wait/notify: a
-// futex on int-sized atomics, no lock); each thread claims a camera by compare-exchange
+// Per frame: the caller rings posted_ (C++20 atomic wait/notify: a futex on int-sized
+// atomics, no lock), then publishes the frame and a generation-tagged camera counter
+// (next_: generation << 32 | next camera); each thread claims a camera by compare-exchange
 // of next_ (a stale worker sees another generation or no camera left and claims nothing);
 // completed_ counts the cameras detected, and the caller returns when it reaches the
 // camera count, so the frame's views stay valid for every claim. No allocation after
@@ -19,7 +19,7 @@
 // the worker early; it then spins for the frame's generation for up to kWarmSpinNs (then
 // sleeps again), so its wake-up overlaps the reading instead of leaving its cameras to
 // the caller. The caller, out of cameras, spins for the worker's last one for up to
-// kFinishSpinNs (one camera's detection) before it sleeps. Both spins only take a core
+// kFinishSpinNs (a few cameras' detection) before it sleeps. Both spins only take a core
 // that the frame leaves idle.
 #pragma once
 
@@ -54,8 +54,8 @@ class ParallelDetect {
   void detect_claimed(std::uint32_t gen) noexcept;
   void run() noexcept;
 
-  static constexpr std::int64_t kWarmSpinNs = 20'000'000;   // longer than a frame's reading
-  static constexpr std::int64_t kFinishSpinNs = 2'000'000;  // longer than one camera
+  static constexpr std::int64_t kWarmSpinNs = 20'000'000;  // longer than a frame's reading
+  static constexpr std::int64_t kFinishSpinNs = 500'000;   // a few cameras' detection
 
   FrameProcessor& proc_;
   // The frame in hand: written by the caller before next_'s release store, read by a
