@@ -14,7 +14,8 @@
 // detection to finish (default-policy threads waited milliseconds on a busy PC; docs/
 // performance.md). Without the privilege Cyclone starts the thread with the default policy
 // and the camera threads' notes say so. A domain this process already created (another
-// NodeDomain, the ROS 2 output) is joined as it is.
+// NodeDomain, the ROS 2 output) is joined as it is. The node's domain batches its writes
+// (NodeDomain::open, batch_writes): its sender flushes after the messages ready at once.
 // Setup functions allocate and return one-line errors; the sample copies are noexcept.
 #pragma once
 
@@ -39,7 +40,11 @@ inline constexpr int kDdsFifoPriority = 85;  // Cyclone's receive thread and our
 // gone, the domain it created.
 class NodeDomain {
  public:
-  static Expected<NodeDomain> open(std::uint32_t domain_id, const std::string& who, bool realtime);
+  // batch_writes: the domain this process creates batches its writes (Cyclone's
+  // Internal/WriteBatch): a write is sent at the writer's next dds_write_flush(), so the
+  // messages written together leave in as few datagrams as fit (the node's sender).
+  static Expected<NodeDomain> open(std::uint32_t domain_id, const std::string& who, bool realtime,
+                                   bool batch_writes = false);
   NodeDomain() = default;
   NodeDomain(NodeDomain&& o) noexcept { *this = static_cast<NodeDomain&&>(o); }
   NodeDomain& operator=(NodeDomain&& o) noexcept;

@@ -1,7 +1,8 @@
 // End-to-end test of the camera nodes (issue 29) on loopback: two `mocap node` processes
 // replay 4 cameras each of an 8-camera recording (fixture node_recording) with `trigger:
 // central`, and one central `mocap run` (pacing lockstep, cameras `backend: node`) tracks
-// them. Checked against the same recording replayed in one process: every frame is
+// them (node n0 on one detection worker, n1 on the default count, min(4 cameras, CPUs)).
+// Checked against the same recording replayed in one process: every frame is
 // published and the joint angles (UDP datagrams) are equal within 1e-5 rad; with one node
 // killed mid-run the central goes on publishing from the other node's cameras and ends
 // normally when the replay ends; the node restarted is used again, in step (its replay
@@ -87,9 +88,11 @@ class NodeCluster : public ::testing::Test {
                                const std::string& central_trigger, int timeout_ms,
                                const std::string& central_keys) {
     for (int n = 0; n < 2; ++n) {
+      // Central-triggered: node n0 detects on one worker, n1 on the default count.
+      const std::string workers = n == 0 && node_trigger == "central" ? ", detect_threads: 1" : "";
       std::string y = "node: {name: n" + std::to_string(n) +
-                      ", domain_id: " + std::to_string(domain_) + "}\npipeline: {" + node_pipeline +
-                      "}\ncameras:\n";
+                      ", domain_id: " + std::to_string(domain_) + workers + "}\npipeline: {" +
+                      node_pipeline + "}\ncameras:\n";
       for (int c = 4 * n; c < 4 * n + 4; ++c)
         y += "  - {backend: replay, device: " + recording() + ", camera: cam" + std::to_string(c) +
              ", trigger: " + node_trigger + "}\n";
