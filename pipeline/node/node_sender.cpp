@@ -39,7 +39,7 @@ NodeSender::~NodeSender() { stop(false); }
 Expected<void> NodeSender::start() {
   stop_.store(false, std::memory_order_relaxed);  // no thread runs yet
   notes_.clear();
-  const int priority = realtime_ ? kDdsFifoPriority : 0;
+  const int priority = realtime_ ? kSenderFifoPriority : 0;
   auto a = rt::start_thread(rt::ThreadSpec{"mocap-nsend", -1, priority}, [this] { send_loop(); });
   if (!a) return a.error();
   send_thread_ = std::move(a).value();

@@ -1,6 +1,7 @@
 // Design: the DDS side of `mocap node` (issue 29), between the node's camera threads
 // (node_runner.h) and the network:
-//   - the sender thread (`mocap-nsend`, SCHED_FIFO kDdsFifoPriority when realtime): takes
+//   - the sender thread (`mocap-nsend`, SCHED_FIFO kSenderFifoPriority when realtime, below
+//     the detection threads, so a write never preempts a detection in progress): takes
 //     every camera's messages from its bounded drop-oldest queue (rt::DropOldestQueue<
 //     WireFrame>, one per camera: one producer at a time; drops are counted and reported in
 //     the camera's health), stamps sent_ns and writes them to mocap/blobs, every message
@@ -41,7 +42,8 @@ struct TriggerStamp {
 class NodeSender {
  public:
   // central[c]: camera c follows the central triggers. queue_depth: messages per camera.
-  // realtime: both threads and Cyclone's receive thread at SCHED_FIFO kDdsFifoPriority.
+  // realtime: Cyclone's receive thread (the trigger listener) at SCHED_FIFO
+  // kDdsFifoPriority, the sender thread at kSenderFifoPriority.
   static Expected<std::unique_ptr<NodeSender>> create(std::uint32_t domain_id,
                                                       const std::vector<bool>& central,
                                                       int queue_depth, bool realtime);
