@@ -115,3 +115,16 @@ function(mocap_add_bench name)
   mocap_target_options(${name})
   target_link_libraries(${name} PRIVATE ${ARG_DEPS} benchmark::benchmark)
 endfunction()
+
+# mocap_add_recording_fixture(<test> FIXTURE <fixture> OUT <dir> SIMULATE <args...>)
+# A recording that several tests read, rendered once per ctest run: the test <test>
+# sets up ctest fixture <fixture> (tests name it in mocap_add_test's FIXTURES) by running
+# `mocap simulate <args> --threads 1` into <dir>.tmp and moving it to <dir> (a test never
+# reads a half-written recording).
+function(mocap_add_recording_fixture test_name)
+  cmake_parse_arguments(ARG "" "FIXTURE;OUT" "SIMULATE" ${ARGN})
+  list(JOIN ARG_SIMULATE " " _args)
+  add_test(NAME ${test_name}
+    COMMAND sh -c "rm -rf '${ARG_OUT}' '${ARG_OUT}.tmp' && $<TARGET_FILE:mocap> simulate ${_args} --threads 1 --out '${ARG_OUT}.tmp' >/dev/null && mv '${ARG_OUT}.tmp' '${ARG_OUT}'")
+  set_tests_properties(${test_name} PROPERTIES FIXTURES_SETUP ${ARG_FIXTURE} TIMEOUT 300)
+endfunction()

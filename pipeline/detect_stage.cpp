@@ -43,7 +43,7 @@ void DetectStage::run() noexcept {
   context_.loop_start(id);
   Doorbell& bell = context_.bell(id);
   Doorbell& next = context_.bell(StageId::kIdentify);
-  const bool every_frame = context_.options().every_frame;
+  const PipelineOptions& options = context_.options();
   BlobTap* const tap = context_.options().blob_tap;
   while (!context_.stopping()) {
     const std::uint32_t seen = bell.snapshot();
@@ -52,9 +52,11 @@ void DetectStage::run() noexcept {
       bell.wait(seen, kIdleWaitNs);
       continue;
     }
+    // Catch-up: the oldest frame while it is fresh, else the next (options.fresh).
+    const std::int64_t now = monotonic_ns();
     hal::Frame newer;
-    while (!every_frame && input_.try_pop(newer)) {  // drop-oldest: work on the freshest frame
-      returned_.try_push(f);                         // cannot fail: holds every camera buffer
+    while (!options.fresh(hal::latency_origin_ns(f), now) && input_.try_pop(newer)) {
+      returned_.try_push(f);  // cannot fail: holds every camera buffer
       counters_.skipped.add();
       f = newer;
     }

@@ -79,14 +79,15 @@ void IdentifyStage::run() noexcept {
     context_.retire(sequence);
   };
   const bool by_time = context_.options().pair_by == PairBy::kTimestamp;
-  const bool every_frame = context_.options().every_frame;
+  const PipelineOptions& options = context_.options();
   bool have_set = false;
   hal::FramePair set{};
   auto take = [&](const hal::FramePair& p) {
     count_unpaired(sequence_of(p));
-    if (have_set && every_frame) {  // in order: the older set first
+    // Catch-up: the older set first while it is fresh, else dropped (options.fresh).
+    if (have_set && options.fresh(origin_of(set), monotonic_ns())) {
       process(set);
-    } else if (have_set) {  // drop-oldest: a newer set is complete
+    } else if (have_set) {  // too old: a newer set is complete
       counters_.skipped.add();
       const std::uint64_t dropped = sequence_of(set);
       release_set(set);

@@ -73,6 +73,10 @@ class IdentifyStage {
     const int c = first_present(set);
     return (*inputs_[static_cast<std::size_t>(c)])[set.cam[c].handle].sequence;
   }
+  std::int64_t origin_of(const hal::FramePair& set) const noexcept {  // the latencies' start
+    const int c = first_present(set);
+    return (*inputs_[static_cast<std::size_t>(c)])[set.cam[c].handle].origin_ns;
+  }
   void process(const hal::FramePair& set) noexcept;
 
   StageContext& context_;

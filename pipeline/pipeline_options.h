@@ -96,12 +96,24 @@ struct PipelineOptions {
   StageHooks* hooks = nullptr;
   FrameTap* tap = nullptr;      // `mocap record`: every delivered frame, capture thread
   BlobTap* blob_tap = nullptr;  // `mocap record --blobs`: every detected frame, detect threads
+  // Catch-up (`pipeline.catch_up_ms`): a stage that finds newer items waiting still takes
+  // the oldest while it is at most catch_up_ns old (since its latency origin: the trigger,
+  // or a replay's delivery), in order; an older one is skipped (detect#_skipped,
+  // identify_skipped, publish_skipped). So a stall the pipeline can make up (the machine,
+  // a slow output) delays a few frames instead of dropping them, and a stage that cannot
+  // keep up sheds the frames too old to matter to a controller. 0: always the newest.
+  std::int64_t catch_up_ns = 25'000'000;
   // true (`mocap record --blobs`, `pipeline.every_frame`): every stage works on every
-  // frame in order instead of the newest (no detect#_skipped, identify_skipped or
-  // publish_skipped): a stall shorter than the rings' depth delays frames and loses none.
-  // A stage that falls behind for longer fills its input ring and the producer drops there
+  // frame in order, however old (no detect#_skipped, identify_skipped or publish_skipped):
+  // a stall shorter than the rings' depth delays frames and loses none. A stage that falls
+  // behind for longer fills its input ring and the producer drops there
   // (capture_dropped_cam#, detect#_no_slot, identify_no_slot).
   bool every_frame = false;
+  // Whether a stage takes an item with this latency origin at now_ns although a newer
+  // one waits.
+  bool fresh(std::int64_t origin_ns, std::int64_t now_ns) const noexcept {
+    return every_frame || now_ns - origin_ns <= catch_up_ns;
+  }
 };
 
 }  // namespace mocap::pipeline

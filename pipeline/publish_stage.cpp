@@ -26,11 +26,13 @@ void PublishStage::run() noexcept {
   Doorbell& bell = context_.bell(StageId::kPublish);
   std::uint64_t skipped_seen = 0;
   std::int64_t prev_publish_ns = 0;
-  const bool every_frame = context_.options().every_frame;
+  const PipelineOptions& options = context_.options();
   while (!context_.stopping()) {
     const std::uint32_t seen = bell.snapshot();
-    rt::SlotHandle h{};  // (set by either pop; GCC's -O1 cannot tell through the choice)
-    if (!(every_frame ? input_.pop(h) : input_.pop_latest(h))) {
+    rt::SlotHandle h{};
+    const std::int64_t now = monotonic_ns();
+    // Catch-up: the oldest message while it is fresh, else the next (options.fresh).
+    if (!input_.pop_fresh(h, [&](const MsgSlot& m) { return options.fresh(m.origin_ns, now); })) {
       bell.wait(seen, kIdleWaitNs);
       continue;
     }

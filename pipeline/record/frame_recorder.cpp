@@ -110,6 +110,14 @@ FrameRecorder::~FrameRecorder() {
   }
 }
 
+void FrameRecorder::attach(pipeline::PipelineOptions& pipeline_options) noexcept {
+  pipeline_options.tap = this;
+  if (options_.blobs) {
+    pipeline_options.blob_tap = this;
+    pipeline_options.every_frame = true;
+  }
+}
+
 void FrameRecorder::start() {
   if (!writer_.joinable()) writer_ = std::thread([this] { writer_loop(); });
 }

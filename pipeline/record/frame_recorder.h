@@ -94,6 +94,12 @@ class FrameRecorder final : public pipeline::FrameTap, public pipeline::BlobTap 
   static Expected<std::unique_ptr<FrameRecorder>> create(const RecorderOptions& options);
   ~FrameRecorder() override;
 
+  // Connects the recorder to the live pipeline's options as `mocap record` runs it: the
+  // frame tap; in blob mode also the blob tap, with every_frame: every stage takes every
+  // frame in order, so the detect stages hand the tap each frame and identify and publish
+  // follow them without skipping (a stall delays frames and drops none while the rings
+  // hold them).
+  void attach(pipeline::PipelineOptions& pipeline_options) noexcept;
   // Starts the writer thread.
   void start();
   // Capture thread (hot path).

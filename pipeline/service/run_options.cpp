@@ -16,6 +16,7 @@ pipeline::PipelineOptions pipeline_options(const config::RunConfig& cfg) {
   o.trigger_rate_hz = cfg.pipeline.trigger_rate_hz;
   o.pacing = cfg.pipeline.pacing;
   o.every_frame = cfg.pipeline.every_frame;
+  o.catch_up_ns = static_cast<std::int64_t>(cfg.pipeline.catch_up_ms) * 1'000'000;
   o.realtime = cfg.pipeline.realtime;
   o.lock_memory = cfg.pipeline.lock_memory;
   o.cpu_latency_us = cfg.pipeline.cpu_latency_us;

@@ -174,11 +174,9 @@ int record(const RecordArgs& a) {
   ro.keep_images_every = static_cast<std::uint32_t>(a.keep_images);
   auto recorder = record::FrameRecorder::create(ro);
   if (!recorder) return fail(recorder.error().message);
-  opt.tap = recorder->get();
-  if (a.blobs) {  // the blob lists of the pipeline's detect stages, every frame in order
-    opt.blob_tap = recorder->get();
-    opt.every_frame = true;
-  }
+  // The images at the capture, or (--blobs) the blob lists of the pipeline's detect
+  // stages, every frame in order.
+  (*recorder)->attach(opt);
   opt.max_frames = trigger_limit;
   auto pipe = pipeline::Pipeline::create((*live)->take_processor(), (*live)->cameras(), {}, opt);
   if (!pipe) return fail(pipe.error().message);

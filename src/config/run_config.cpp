@@ -141,13 +141,15 @@ void read_cameras(const YAML::Node& node, const std::string& dir, RunConfig& cfg
 void read_pipeline(const YAML::Node& node, PipelineSettings& p) {
   const Section s(node, "pipeline",
                   {"trigger_rate_hz", "pacing", "realtime", "lock_memory", "cpu_latency_us",
-                   "dequeue_timeout_ms", "stages", "pair_by", "pair_tolerance_us", "every_frame"});
+                   "dequeue_timeout_ms", "stages", "pair_by", "pair_tolerance_us", "every_frame",
+                   "catch_up_ms"});
   config_detail::read_pair_keys(s, p);
   set(p.trigger_rate_hz, s.number("trigger_rate_hz", kMinTriggerRateHz, kMaxTriggerRateHz));
   set(p.pacing, s.choice<TriggerPacing>("pacing", {{"periodic", TriggerPacing::kPeriodic},
                                                    {"lockstep", TriggerPacing::kLockstep}}));
   set(p.realtime, s.flag("realtime"));
   set(p.every_frame, s.flag("every_frame"));
+  set(p.catch_up_ms, s.integer("catch_up_ms", 0, kMaxCatchUpMs));
   set(p.lock_memory, s.flag("lock_memory"));
   // rt::kMaxCpuLatencyUs (rt/cpu_latency.h; config does not link the rt layer).
   set(p.cpu_latency_us, s.integer("cpu_latency_us", -1, 1'000'000));

@@ -76,6 +76,7 @@ struct PipelineSettings {
   TriggerPacing pacing = TriggerPacing::kPeriodic;
   bool realtime = true;      // CPU pinning + SCHED_FIFO (falls back when not permitted)
   bool every_frame = false;  // every stage works on every frame in order (not the newest)
+  int catch_up_ms = 25;      // older frames a stage still takes in order; 0: the newest
   bool lock_memory = true;   // mlockall (falls back when not permitted)
   int cpu_latency_us = 0;    // PM QoS CPU latency while running; -1: none (rt/cpu_latency.h)
   int dequeue_timeout_ms = 20;
@@ -169,6 +170,7 @@ struct RunConfig {
 // The ranges of the settings a command-line flag may also set, and their one check:
 // the file's keys (pipeline.trigger_rate_hz, sim.loop_frames) and the flags (--rate,
 // --loop-frames) are validated by these, so both accept exactly the same values.
+inline constexpr int kMaxCatchUpMs = 10'000;  // pipeline.catch_up_ms
 inline constexpr int kMinLoopFrames = 2;
 inline constexpr int kMaxLoopFrames = 2000;
 inline constexpr int kHumanoidLoopFrames = 100;  // sim.loop_frames' default for the humanoid

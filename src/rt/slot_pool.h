@@ -10,9 +10,11 @@
 // a handle through a ring (release store / acquire load) publishes the slot's data.
 //
 // Drop policy ("the capture never blocks"): the producer never waits.
-//   - Consumer side, drop-oldest: pop_latest() takes the newest ready slot and hands
-//     every older ready slot straight back to the free ring, counting each in
-//     skipped(). A stage that falls behind thus processes the freshest frame.
+//   - Consumer side, drop-oldest: pop_fresh(fresh) takes the oldest ready slot that
+//     `fresh` accepts (e.g. "at most 25 ms old"), or else the newest, and hands every
+//     older ready slot it passes over straight back to the free ring, counting each in
+//     skipped(). A stage that falls behind thus catches up on the frames that still
+//     matter and sheds the rest; pop() (all fresh) and pop_latest() (none) are its ends.
 //   - Producer side: acquire() fails only when every slot is queued or held (the
 //     consumer has not run for slot_count - 1 frames); the producer then drops the
 //     incoming frame, counted in dropped(). Size the pool so this cannot happen while
@@ -86,10 +88,17 @@ class SlotPool {
   bool pop(SlotHandle& out) noexcept { return ready_.try_pop(out); }
   // The newest ready slot; every older ready slot is released and counted as skipped.
   bool pop_latest(SlotHandle& out) noexcept {
+    return pop_fresh(out, [](const Slot&) { return false; });
+  }
+  // The oldest ready slot that fresh(slot) accepts, or else the newest: every older ready
+  // slot it passes over is released and counted as skipped (pop(): every slot fresh;
+  // pop_latest(): none). The consumer's catch-up policy, e.g. "at most N ms old".
+  template <class Fresh>
+  bool pop_fresh(SlotHandle& out, Fresh&& fresh) noexcept {
     SlotHandle h;
     if (!ready_.try_pop(h)) return false;
     SlotHandle next;
-    while (ready_.try_pop(next)) {
+    while (!fresh(static_cast<const Slot&>(slots_[h])) && ready_.try_pop(next)) {
       free_.try_push(h);  // cannot fail: the free ring holds every slot
       skipped_.add();
       h = next;

@@ -2,6 +2,7 @@
 #include "stereo/multiview.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdlib>
 #include <string>
@@ -236,25 +237,35 @@ void MultiViewMerger::settle(int i) noexcept {
 // The candidates of one pair, in order (hypothesis indices run on across the pairs of the
 // frame). A candidate of two blobs that EARLIER pairs settled (hypothesis index before
 // this pair's first) is none: the pairwise stage given SettledBlobs never makes it.
+// Every candidate of a pair's list uses the pair's two cameras, so they are looked up
+// once, in the first candidate; a candidate with other views (none of the pairwise
+// stage's) is a hypothesis without the settled test.
 void MultiViewMerger::add_pair(const PointList& pair, const Vec2* const* px) noexcept {
   const int first = count_;
   const std::size_t per_cam = static_cast<std::size_t>(config_.max_points_per_camera);
   const bool pass_through = camera_count() == 2;  // one pair: its candidates are the answer
+  // The pair's two cameras, from its first candidate, and their mask.
+  int cam[2] = {-1, -1};
+  CameraMask pair_mask = 0;
+  if (config_.settle_blobs && !pass_through && !pair.empty() &&
+      pair.begin()->blob_index.count() == 2) {
+    pair_mask = pair.begin()->blob_index.mask();
+    cam[0] = std::countr_zero(pair_mask);
+    cam[1] = std::countr_zero(pair_mask & (pair_mask - 1));
+  }
+  // Per view of the pair: the blob's settling hypothesis from an earlier pair, -1: none.
+  const auto settled_earlier = [&](int e, const Point3& c) noexcept {
+    const int j = c.blob_index[cam[e]];
+    const int by =
+        j < config_.max_points_per_camera
+            ? settled_by_[static_cast<std::size_t>(cam[e]) * per_cam + static_cast<std::size_t>(j)]
+            : -1;
+    return by < first ? by : -1;  // settled by earlier pairs only
+  };
   for (const Point3& c : pair) {
-    int cam[2] = {-1, -1}, k = 0;
-    for (int v = 0; v < camera_count() && k < 2; ++v)
-      if (c.blob_index[v] >= 0) cam[k++] = v;
-    if (k == 2 && config_.settle_blobs && !pass_through) {
-      int code[2];
-      for (int e = 0; e < 2; ++e) {
-        const int j = c.blob_index[cam[e]];
-        const int by = j < config_.max_points_per_camera
-                           ? settled_by_[static_cast<std::size_t>(cam[e]) * per_cam +
-                                         static_cast<std::size_t>(j)]
-                           : -1;
-        code[e] = by < first ? by : -1;  // settled by earlier pairs only
-      }
-      if (settled_pair(code[0], code[1])) {
+    if (pair_mask != 0 && c.blob_index.mask() == pair_mask) {
+      const int settled[2] = {settled_earlier(0, c), settled_earlier(1, c)};
+      if (settled_pair(settled[0], settled[1])) {
         ++counters_.settled;
         continue;
       }

@@ -2,6 +2,7 @@
 // available points, labelling from the roots, the solve/test/drop loop, and every
 // joint's solved-by flag and standard deviations.
 #include <Eigen/Eigenvalues>
+#include <Eigen/LU>
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -278,8 +279,14 @@ Mat3 ChainSolver::body_cov(int b, const BodyPoses& poses, const ChainResult& out
       const Vec3 r = bp.T_world_body.linear() * (markers[m] - mean);
       A += r.squaredNorm() * Mat3::Identity() - r * r.transpose();
     }
-    const Eigen::FullPivLU<Mat3> lu(A);
-    return lu.isInvertible() ? Mat3(s2 * lu.inverse()) : Mat3(Mat3::Identity());
+    // A is symmetric positive semi-definite: its closed-form inverse, unless it is
+    // singular to rounding (markers on one line).
+    Mat3 A_inv;
+    double det = 0.0;
+    bool invertible = false;
+    const double tr = A.trace();
+    A.computeInverseAndDetWithCheck(A_inv, det, invertible, 1e-14 * tr * tr * tr);
+    return invertible && tr > 0.0 ? Mat3(s2 * A_inv) : Mat3(Mat3::Identity());
   }
   const int j = model_.joint_into(b);
   const ChainJoint& cj = model_.joint(j);

@@ -25,6 +25,7 @@
 #include <numbers>
 
 #include "core/rotation.h"
+#include "core/small_cholesky.h"
 #include "identify/consistency.h"
 #include "track/chain_solver.h"
 
@@ -75,13 +76,8 @@ bool ChainSolver::refit_child(int j, const JointEvidence& ev, const MeasuredPoin
     if (labels[k] >= n) labels[k] = -1;
   const double q3 = chi2_quantile(3, config_.confidence);
   const double q2 = chi2_quantile(2, config_.confidence);
-  // Residuals and Jacobians (rotation increment left-multiplied, world frame) at (R, t).
-  const auto marker_term = [&](const Mat3& R, const Vec3& t, std::size_t k, Vec3& r, Jac3& J) {
-    const Vec3 Rx = R * markers[k];
-    r = Rx + t - pts[labels[k]].X_world;
-    J.leftCols<3>() = -skew3(Rx);
-    J.rightCols<3>() = Mat3::Identity();
-  };
+  // Residual and Jacobian (rotation increment left-multiplied, world frame) at (R, t) of
+  // the joint centre.
   const auto centre_term = [&](const Mat3& R, const Vec3& t, Vec3& r, Jac3& J) {
     const Vec3 Rx = R * cj.c_child;
     r = Rx + t - ev.c_w;
@@ -95,23 +91,41 @@ bool ChainSolver::refit_child(int j, const JointEvidence& ev, const MeasuredPoin
     J.leftCols<3>() = -ev.U.transpose() * skew3(b);
     J.rightCols<3>().setZero();
   };
-  // Normal equations and weighted sum of squares of every term at (R, t).
+  // Each marker's weight: its measurement noise alone (constant over the refit).
+  std::array<double, kMaxMarkers> w{};
+  for (std::size_t k = 0; k < markers.size(); ++k)
+    if (labels[k] >= 0) w[k] = 1.0 / point_sigma_sq(labels[k], pts[labels[k]]);
+  // Normal equations and weighted sum of squares of every term at (R, t). A marker's
+  // Jacobian is [-[a]x, I] with a = R x_k, so J^T J = [[|a|^2 I - a a^T, [a]x], [-[a]x, I]]
+  // and J^T r = [a x r; r]: the markers are summed in closed form (the sums of w, w a,
+  // w |a|^2 and w a a^T), not as 6x6 products.
   const auto normal = [&](const Mat3& R, const Vec3& t, Mat6& H, Vec6& g, int& m) {
-    H.setZero();
-    g.setZero();
-    double chi2 = 0.0;
+    double chi2 = 0.0, sw = 0.0, swaa = 0.0;
+    Vec3 swa = Vec3::Zero(), g_rot = Vec3::Zero(), g_tra = Vec3::Zero();
+    Mat3 outer = Mat3::Zero();
     m = 0;
-    Vec3 r;
-    Jac3 J;
     for (std::size_t k = 0; k < markers.size(); ++k) {
       if (labels[k] < 0) continue;
-      marker_term(R, t, k, r, J);
-      const double w = 1.0 / point_sigma_sq(labels[k], pts[labels[k]]);
-      H += w * J.transpose() * J;
-      g += w * J.transpose() * r;
-      chi2 += w * r.squaredNorm();
+      const Vec3 a = R * markers[k];
+      const Vec3 r = a + t - pts[labels[k]].X_world;
+      const double wk = w[k];
+      sw += wk;
+      swa += wk * a;
+      swaa += wk * a.squaredNorm();
+      outer.noalias() += (wk * a) * a.transpose();
+      g_rot += wk * a.cross(r);
+      g_tra += wk * r;
+      chi2 += wk * r.squaredNorm();
       ++m;
     }
+    H.topLeftCorner<3, 3>() = swaa * Mat3::Identity() - outer;
+    H.topRightCorner<3, 3>() = skew3(swa);
+    H.bottomLeftCorner<3, 3>() = skew3(swa).transpose();
+    H.bottomRightCorner<3, 3>() = sw * Mat3::Identity();
+    g.head<3>() = g_rot;
+    g.tail<3>() = g_tra;
+    Vec3 r;
+    Jac3 J;
     centre_term(R, t, r, J);
     H += J.transpose() * ev.W_c * J;
     g += J.transpose() * ev.W_c * r;
@@ -133,22 +147,29 @@ bool ChainSolver::refit_child(int j, const JointEvidence& ev, const MeasuredPoin
     Vec6 g;
     int m = 0;
     double chi2 = 0.0;
+    SmallCholesky<6> chol;
+    bool at_pose = false;  // H, g, chi2 and chol belong to (R, t)
     for (int iter = 0; iter < 6; ++iter) {
       chi2 = normal(R, t, H, g, m);
       if (m < 2) return false;
-      const Eigen::LDLT<Mat6> ldlt(H);
-      if (ldlt.info() != Eigen::Success) return false;
-      const Vec6 step = ldlt.solve(-g);
+      if (!chol.compute(H)) return false;
+      const Vec6 step = chol.solve(-g);
       if (!step.allFinite()) return false;
-      if (step.cwiseAbs().maxCoeff() < 1e-10) break;
+      if (step.cwiseAbs().maxCoeff() < 1e-10) {
+        at_pose = true;
+        break;
+      }
       const double a = step.head<3>().norm();
       const Mat3 dR =
           a > 1e-15 ? Mat3(Eigen::AngleAxisd(a, step.head<3>() / a)) : Mat3(Mat3::Identity());
       R = dR * R;
       t = dR * t + step.tail<3>();
     }
-    chi2 = normal(R, t, H, g, m);
-    const Mat6 C = H.ldlt().solve(Mat6::Identity());
+    if (!at_pose) {
+      chi2 = normal(R, t, H, g, m);
+      if (!chol.compute(H)) return false;
+    }
+    const Mat6 C = chol.inverse();
     // Each term tested alone: the drop of the sum of squares when it leaves the fit,
     // r^T (Sigma - J C J^T)^-1 r (a biased marker is diluted in the global sum, and the
     // fit absorbs most of it along the directions its spread leaves loose). As a share of
@@ -157,11 +178,19 @@ bool ChainSolver::refit_child(int j, const JointEvidence& ev, const MeasuredPoin
     int worst_k = -1;
     Vec3 r;
     Jac3 J;
+    // A marker's J C J^T with J = [-[a]x, I]: [a]x C_rr [a]x^T - B - B^T + C_tt,
+    // B = [a]x C_rt.
+    const Mat3 C_rr = C.topLeftCorner<3, 3>();
+    const Mat3 C_rt = C.topRightCorner<3, 3>();
+    const Mat3 C_tt = C.bottomRightCorner<3, 3>();
     for (std::size_t k = 0; k < markers.size(); ++k) {
       if (labels[k] < 0) continue;
-      marker_term(R, t, k, r, J);
-      const Mat3 S =
-          point_sigma_sq(labels[k], pts[labels[k]]) * Mat3::Identity() - J * C * J.transpose();
+      const Vec3 a = R * markers[k];
+      r = a + t - pts[labels[k]].X_world;
+      const Mat3 S_a = skew3(a);
+      const Mat3 B = S_a * C_rt;
+      const Mat3 S = (1.0 / w[k]) * Mat3::Identity() -
+                     (S_a * C_rr * S_a.transpose() - B - B.transpose() + C_tt);
       const double d = r.dot(S.ldlt().solve(r)) / q3;
       if (std::isfinite(d) && d > worst) worst = d, worst_k = static_cast<int>(k);
     }
@@ -196,6 +225,15 @@ void ChainSolver::check_pose_joints(const MeasuredPoint* pts, int n, const BodyP
   const auto reject = [&](std::size_t uj) {
     out.joints[uj] = ChainJointResult{client::SolvedBy::kNone, {}, true};
     ++counters_.pose_rejects;
+  };
+  // The largest rotation variance within max_sd_deg^2. A covariance's eigenvalues are not
+  // negative, so a trace within it settles the test without the eigenvalues.
+  const double max_var = std::pow(config_.max_sd_deg * std::numbers::pi / 180.0, 2);
+  const auto certain = [max_var](const Mat3& cov) {
+    if (cov.trace() <= max_var) return true;
+    return Eigen::SelfAdjointEigenSolver<Mat3>(cov, Eigen::EigenvaluesOnly)
+               .eigenvalues()
+               .maxCoeff() <= max_var;
   };
   for (const int j : model_.order()) {
     const auto uj = static_cast<std::size_t>(j);
@@ -238,11 +276,7 @@ void ChainSolver::check_pose_joints(const MeasuredPoint* pts, int n, const BodyP
     Mat3 cov_R;
     // Like a chain angle, the refitted pose must be certain enough (with 2 markers left
     // it may not be: markers nearly in line with the centre).
-    if (!refit_child(j, ev, pts, n, child, labels, T_wc, cov_R) ||
-        !(std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Mat3>(cov_R, Eigen::EigenvaluesOnly)
-                                      .eigenvalues()
-                                      .maxCoeff())) <=
-          config_.max_sd_deg * std::numbers::pi / 180.0)) {
+    if (!refit_child(j, ev, pts, n, child, labels, T_wc, cov_R) || !certain(cov_R)) {
       reject(uj);
       continue;
     }

@@ -2,6 +2,7 @@
 #include "track/detect_workers.h"
 
 #include "core/clock.h"
+#include "rt/cpu_relax.h"
 
 namespace mocap {
 
@@ -40,14 +41,37 @@ void ParallelDetect::detect_claimed(std::uint32_t gen) noexcept {
 
 void ParallelDetect::run() noexcept {
   std::uint32_t seen = 0;
+  std::uint32_t taken = 0;  // the last generation whose cameras this thread claimed
   for (;;) {
-    // acquire: pairs with the caller's (or the destructor's) release store, so stop_ is
-    // seen; the frame itself is published through next_ (detect_claimed).
+    // acquire: pairs with the caller's (or the destructor's) release increment, so stop_
+    // is seen; the frame itself is published through next_ (detect_claimed).
     posted_.wait(seen, std::memory_order_acquire);
     seen = posted_.load(std::memory_order_acquire);
-    if (stop_.load(std::memory_order_acquire)) return;
-    detect_claimed(seen);
+    // Rung for a frame or by warm(): spin until a new generation is posted (bounded).
+    const std::int64_t t0 = monotonic_ns();
+    for (;;) {
+      if (stop_.load(std::memory_order_acquire)) return;
+      // acquire: pairs with the caller's release store of the generation, so the bell the
+      // caller rang before it (detect()) is in the load of posted_ below.
+      const auto gen = static_cast<std::uint32_t>(next_.load(std::memory_order_acquire) >> 32);
+      if (gen != taken) {
+        taken = gen;
+        // This frame's bell is consumed: sleep until the next warm() or frame, instead of
+        // spinning through the frame's other stages.
+        seen = posted_.load(std::memory_order_relaxed);
+        detect_claimed(gen);
+        break;
+      }
+      if (monotonic_ns() - t0 > kWarmSpinNs) break;
+      rt::cpu_relax();
+    }
   }
+}
+
+void ParallelDetect::warm() noexcept {
+  // release: orders nothing of the frame (next_ publishes it); the increment is the bell.
+  posted_.fetch_add(1, std::memory_order_release);
+  posted_.notify_one();
 }
 
 void ParallelDetect::detect(std::span<const ImageView* const> views, FrameOutput& out) noexcept {
@@ -57,15 +81,23 @@ void ParallelDetect::detect(std::span<const ImageView* const> views, FrameOutput
   views_ = views;
   out_ = &out;
   completed_.store(0, std::memory_order_relaxed);
-  const std::uint32_t gen = posted_.load(std::memory_order_relaxed) + 1;
+  const std::uint32_t gen = ++generation_;
+  // The bell before the frame: a worker that sees the generation (acquire) also sees the
+  // bell, so it does not wake again for this frame. release: pairs with the worker's wait.
+  posted_.fetch_add(1, std::memory_order_release);
+  posted_.notify_one();
   // release: publishes views_, out_ and the reset count with the generation's counter.
   next_.store(static_cast<std::uint64_t>(gen) << 32, std::memory_order_release);
-  posted_.store(gen, std::memory_order_release);
-  posted_.notify_one();
   detect_claimed(gen);
   // acquire: pairs with each claim's release increment; every blob list is complete.
-  for (std::uint32_t k = completed_.load(std::memory_order_acquire); k != n;
-       k = completed_.load(std::memory_order_acquire))
+  // The worker's last camera is short: spin for it first, then sleep.
+  const std::int64_t t_spin = monotonic_ns();
+  std::uint32_t k = completed_.load(std::memory_order_acquire);
+  while (k != n && monotonic_ns() - t_spin < kFinishSpinNs) {
+    rt::cpu_relax();
+    k = completed_.load(std::memory_order_acquire);
+  }
+  for (; k != n; k = completed_.load(std::memory_order_acquire))
     completed_.wait(k, std::memory_order_acquire);
   out.times.detect = monotonic_ns() - t0;
 }

@@ -7,14 +7,20 @@
 // identification, angles) then run on the calling thread. The output is exactly
 // FrameProcessor::process's: every camera has its own detector and blob list, and
 // detect_camera() is thread-safe between different cameras.
-// Per frame: the caller publishes the frame and a generation-tagged camera counter
-// (next_: generation << 32 | next camera) and rings posted_ (C++20 atomic wait/notify: a
-// futex on int-sized atomics, no lock); each thread claims a camera by compare-exchange
+// Per frame: the caller rings posted_ (C++20 atomic wait/notify: a futex on int-sized
+// atomics, no lock), then publishes the frame and a generation-tagged camera counter
+// (next_: generation << 32 | next camera); each thread claims a camera by compare-exchange
 // of next_ (a stale worker sees another generation or no camera left and claims nothing);
 // completed_ counts the cameras detected, and the caller returns when it reaches the
 // camera count, so the frame's views stay valid for every claim. No allocation after
 // construction. Timings are wall-clock, as in process(): `detect` is the time until
 // every camera of the frame was detected.
+// Wake-ups off the frame's time: warm() (called before the frame's files are read) rings
+// the worker early; it then spins for the frame's generation for up to kWarmSpinNs (then
+// sleeps again), so its wake-up overlaps the reading instead of leaving its cameras to
+// the caller. The caller, out of cameras, spins for the worker's last one for up to
+// kFinishSpinNs (a few cameras' detection) before it sleeps. Both spins only take a core
+// that the frame leaves idle.
 #pragma once
 
 #include <atomic>
@@ -37,6 +43,8 @@ class ParallelDetect {
   // Stage 1 alone (out.blobs, out.camera_present, out.times.detect), split over the two
   // threads; the caller then runs FrameProcessor::process_blobs.
   void detect(std::span<const ImageView* const> views, FrameOutput& out) noexcept;
+  // A frame follows soon (its files are being read): the worker wakes now.
+  void warm() noexcept;
   // FrameProcessor::process with the detection split over the two threads.
   bool process(std::span<const ImageView* const> views, std::int64_t timestamp_ns,
                FrameOutput& out) noexcept;
@@ -46,13 +54,17 @@ class ParallelDetect {
   void detect_claimed(std::uint32_t gen) noexcept;
   void run() noexcept;
 
+  static constexpr std::int64_t kWarmSpinNs = 20'000'000;  // longer than a frame's reading
+  static constexpr std::int64_t kFinishSpinNs = 500'000;   // a few cameras' detection
+
   FrameProcessor& proc_;
   // The frame in hand: written by the caller before next_'s release store, read by a
   // thread after its acquire compare-exchange of next_ claimed one of its cameras.
   std::span<const ImageView* const> views_;
   FrameOutput* out_ = nullptr;
   std::atomic<std::uint64_t> next_{0};       // generation << 32 | next camera to claim
-  std::atomic<std::uint32_t> posted_{0};     // the generation posted (the worker's doorbell)
+  std::uint32_t generation_ = 0;             // the caller's last frame
+  std::atomic<std::uint32_t> posted_{0};     // the worker's doorbell: frames and warm()
   std::atomic<std::uint32_t> completed_{0};  // cameras of this generation detected
   std::atomic<bool> stop_{false};
   std::thread worker_;

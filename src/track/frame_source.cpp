@@ -20,6 +20,7 @@ FrameSource::Result FrameSource::load(std::int64_t frame, FrameOutput& out) {
   const int n = proc_.camera_count();
   const std::int64_t t_read = monotonic_ns();
   if (!rec_.has_blobs()) {
+    if (parallel_) parallel_->warm();  // its wake-up overlaps the reading
     const FrameSetLoader::Result loaded = images_->load(frame);
     out.times.load = monotonic_ns() - t_read;
     r.missing = loaded.missing;

@@ -144,6 +144,7 @@ TEST(RunConfig, ThresholdsAndOutputsAreRead) {
       "stereo: {epipolar_tolerance_px: 1.5, min_depth_mm: 200, max_depth_mm: 5000}\n"
       "identification: {t_mm: 4, min_markers: 4, temporal: false}\n"
       "pipeline: {pacing: lockstep, realtime: false, cpu_latency_us: 50, every_frame: true,\n"
+      "           catch_up_ms: 40,\n"
       "           stages: {publish: {cpu: -1}}}\n"
       "fault_injection: {stall_after_frames: 50}\n");
   auto cfg = load_run_config(dir.file("m.yaml"));
@@ -160,6 +161,7 @@ TEST(RunConfig, ThresholdsAndOutputsAreRead) {
   EXPECT_EQ(cfg->pipeline.pacing, TriggerPacing::kLockstep);
   EXPECT_FALSE(cfg->pipeline.realtime);
   EXPECT_TRUE(cfg->pipeline.every_frame);
+  EXPECT_EQ(cfg->pipeline.catch_up_ms, 40);
   EXPECT_EQ(cfg->pipeline.cpu_latency_us, 50);
   EXPECT_EQ(*cfg->pipeline.stages[3].cpu, -1);
   EXPECT_EQ(cfg->faults.stall_after_frames, 50u);

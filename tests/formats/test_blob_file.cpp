@@ -1,17 +1,17 @@
-// Tests of the blob file (formats/blob_file.h) and blob recordings (formats/recording.h):
-// random round trips stored bit-exact, truncation at every byte offset (torn tail: the
-// whole frames before it read, one warning), a damaged chunk in the middle skipped and
-// reported, header errors, hostile sizes, the full-disk writer, and Recording's
-// recognition and per-frame reads of a blob recording.
+// Tests of the blob file (formats/blob_file.h) and blob recordings (formats/recording.h),
+// writing and reading: random round trips stored bit-exact, reads without allocation, the
+// writer's refusals and its full-disk cut-back, a file written independently from the
+// documented layout read and re-written byte for byte, and Recording's recognition and
+// per-frame reads of a blob recording. Damaged files: test_blob_file_damage.cpp.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include <bit>
 #include <filesystem>
 #include <random>
 
 #include "formats/blob_file.h"
 #include "formats/recording.h"
+#include "tests/formats/blob_file_test_util.h"
 #include "tests/formats/formats_test_util.h"
 #include "tests/support/alloc_counter.h"
 #include "tests/support/test_support.h"
@@ -19,103 +19,13 @@
 namespace mocap {
 namespace {
 
+using test::expect_reads;
+using test::expect_same_bits;
+using test::test_info;
+using test::write_random;
+using test::Written;
 using ::testing::HasSubstr;
 using ::testing::StartsWith;
-
-detect::Blob random_blob(std::mt19937_64& rng) {
-  std::uniform_real_distribution<double> px(0.0, 1031.0);
-  std::uniform_real_distribution<float> f(-10.0f, 500.0f);
-  std::uniform_int_distribution<int> box(0, 1031);
-  std::uniform_int_distribution<std::uint32_t> u16(0, 65535);
-  detect::Blob b;
-  b.x_px = px(rng);
-  b.y_px = std::bit_cast<double>(rng() & 0x7fefffffffffffffull);  // any finite double
-  b.area_px = f(rng);
-  b.sum_dn = std::bit_cast<float>(static_cast<std::uint32_t>(rng()) & 0x7f7fffffu);
-  b.peak_dn = static_cast<std::uint16_t>(u16(rng));
-  b.background_dn = static_cast<std::uint16_t>(u16(rng));
-  b.x_min = box(rng);
-  b.y_min = box(rng);
-  b.x_max = box(rng);
-  b.y_max = box(rng);
-  b.major_axis_px = f(rng);
-  b.minor_axis_px = f(rng);
-  b.roundness = f(rng);
-  b.eccentricity = f(rng);
-  b.orientation_rad = f(rng);
-  b.flags = static_cast<std::uint32_t>(rng());
-  return b;
-}
-
-void expect_same_bits(const detect::Blob& a, const detect::Blob& b) {
-  EXPECT_EQ(std::bit_cast<std::uint64_t>(a.x_px), std::bit_cast<std::uint64_t>(b.x_px));
-  EXPECT_EQ(std::bit_cast<std::uint64_t>(a.y_px), std::bit_cast<std::uint64_t>(b.y_px));
-  EXPECT_EQ(std::bit_cast<std::uint32_t>(a.area_px), std::bit_cast<std::uint32_t>(b.area_px));
-  EXPECT_EQ(std::bit_cast<std::uint32_t>(a.sum_dn), std::bit_cast<std::uint32_t>(b.sum_dn));
-  EXPECT_EQ(a.peak_dn, b.peak_dn);
-  EXPECT_EQ(a.background_dn, b.background_dn);
-  EXPECT_EQ(a.x_min, b.x_min);
-  EXPECT_EQ(a.y_min, b.y_min);
-  EXPECT_EQ(a.x_max, b.x_max);
-  EXPECT_EQ(a.y_max, b.y_max);
-  for (auto m :
-       {&detect::Blob::major_axis_px, &detect::Blob::minor_axis_px, &detect::Blob::roundness,
-        &detect::Blob::eccentricity, &detect::Blob::orientation_rad})
-    EXPECT_EQ(std::bit_cast<std::uint32_t>(a.*m), std::bit_cast<std::uint32_t>(b.*m));
-  EXPECT_EQ(a.flags, b.flags);
-}
-
-BlobFileInfo test_info(std::uint32_t max_blobs = 64) {
-  BlobFileInfo info;
-  info.camera = "cam0";
-  info.width = 1032;
-  info.height = 776;
-  info.max_blobs = max_blobs;
-  return info;
-}
-
-struct Written {
-  std::vector<std::int64_t> frames;
-  std::vector<detect::BlobList> lists;
-};
-
-// Writes `n` frames (numbers with gaps) of random blob lists to `path`.
-Written write_random(const std::string& path, int n, std::mt19937_64& rng, int max_count = 20) {
-  auto w = BlobFileWriter::create(path, test_info(), 0);
-  EXPECT_TRUE(w.ok()) << w.error().message;
-  Written out;
-  std::int64_t frame = 0;
-  for (int i = 0; i < n; ++i) {
-    detect::BlobList list(64);
-    const int count = static_cast<int>(rng() % static_cast<std::uint64_t>(max_count + 1));
-    for (int k = 0; k < count; ++k) list.push_back(random_blob(rng));
-    list.set_levels({std::bit_cast<double>(rng() & 0x3fffffffffffffffull), 1.0 / 3.0, 17.25});
-    frame += 1 + static_cast<std::int64_t>(rng() % 3);
-    EXPECT_TRUE(w->append(frame, frame * 4'000'000 + 7, list).ok());
-    out.frames.push_back(frame);
-    out.lists.push_back(list);
-  }
-  EXPECT_TRUE(w->close().ok());
-  return out;
-}
-
-void expect_reads(const BlobFileReader& r, const Written& w, std::size_t n) {
-  ASSERT_EQ(r.chunks().size(), n);
-  detect::BlobList got(64);
-  std::vector<std::uint8_t> scratch;
-  for (std::size_t i = 0; i < n; ++i) {
-    const BlobFileReader::Chunk* c = r.find(w.frames[i]);
-    ASSERT_NE(c, nullptr);
-    EXPECT_EQ(c->timestamp_ns, w.frames[i] * 4'000'000 + 7);
-    ASSERT_TRUE(r.load(*c, got, scratch).ok());
-    ASSERT_EQ(got.size(), w.lists[i].size());
-    EXPECT_EQ(std::bit_cast<std::uint64_t>(got.levels().background_dn),
-              std::bit_cast<std::uint64_t>(w.lists[i].levels().background_dn));
-    EXPECT_EQ(got.levels().noise_dn, 1.0 / 3.0);
-    EXPECT_EQ(got.levels().threshold_dn, 17.25);
-    for (std::size_t k = 0; k < got.size(); ++k) expect_same_bits(got[k], w.lists[i][k]);
-  }
-}
 
 TEST(BlobFile, RandomRoundTripsAreBitExact) {
   test::TempDir dir("blob_rt");
@@ -147,131 +57,6 @@ TEST(BlobFile, ReadingAFrameAllocatesNothingOnceTheScratchHasGrown) {
   test::AllocationScope counter;
   for (const BlobFileReader::Chunk& c : r->chunks()) ASSERT_TRUE(r->load(c, got, scratch).ok());
   EXPECT_EQ(counter.count(), 0u);
-}
-
-TEST(BlobFile, TruncationAtEveryOffsetKeepsEveryWholeFrame) {
-  test::TempDir dir("blob_trunc");
-  std::mt19937_64 rng(7);
-  const std::string full = dir.file("full.blobs");
-  const Written w = write_random(full, 4, rng, 3);
-  const std::string bytes = test::read_file(full);
-  std::vector<std::size_t> ends;  // byte offset after each whole chunk
-  {
-    std::vector<std::string> warnings;
-    auto r = BlobFileReader::open(full, warnings);
-    ASSERT_TRUE(r.ok());
-    for (const auto& c : r->chunks())
-      ends.push_back(c.offset + kBlobChunkHeaderBytes + c.count * kBlobRecordBytes + 4);
-  }
-  const std::size_t header = 32 + 4 + 4;  // "cam0"
-  const std::string cut = dir.file("cut.blobs");
-  for (std::size_t len = 0; len <= bytes.size(); ++len) {
-    test::write_file(cut, bytes.substr(0, len));
-    std::vector<std::string> warnings;
-    auto r = BlobFileReader::open(cut, warnings);
-    if (len < header) {
-      ASSERT_FALSE(r.ok()) << len;
-      EXPECT_THAT(r.error().message, StartsWith(cut + ": "));
-      continue;
-    }
-    ASSERT_TRUE(r.ok()) << len << ": " << r.error().message;
-    std::size_t whole = 0;
-    while (whole < ends.size() && ends[whole] <= len) ++whole;
-    expect_reads(*r, w, whole);
-    const bool at_boundary = len == header || (whole > 0 && ends[whole - 1] == len);
-    if (at_boundary) {
-      EXPECT_TRUE(warnings.empty()) << len;
-    } else {
-      ASSERT_EQ(warnings.size(), 1u) << len;
-      const std::size_t tail = whole > 0 ? ends[whole - 1] : header;
-      EXPECT_THAT(warnings[0],
-                  StartsWith(cut + ": torn tail at byte offset " + std::to_string(tail) + " ("));
-      EXPECT_EQ(r->torn_bytes(), len - tail);
-    }
-  }
-}
-
-TEST(BlobFile, DamagedChunkInTheMiddleIsSkippedAndReported) {
-  test::TempDir dir("blob_damage");
-  std::mt19937_64 rng(11);
-  const std::string path = dir.file("d.blobs");
-  Written w = write_random(path, 5, rng, 4);
-  std::vector<std::string> warnings;
-  std::uint64_t second = 0, third = 0;
-  {
-    auto r = BlobFileReader::open(path, warnings);
-    ASSERT_TRUE(r.ok());
-    second = r->chunks()[1].offset;
-    third = r->chunks()[2].offset;
-  }
-  for (std::uint64_t at :
-       {second, second + 5, second + 20, third - 1}) {  // sync, count, frame, CRC
-    std::string bytes = test::read_file(path);
-    bytes[at] = static_cast<char>(bytes[at] ^ 0x5a);
-    const std::string bad = dir.file("bad.blobs");
-    test::write_file(bad, bytes);
-    warnings.clear();
-    auto r = BlobFileReader::open(bad, warnings);
-    ASSERT_TRUE(r.ok()) << r.error().message;
-    ASSERT_EQ(warnings.size(), 1u) << at;
-    EXPECT_THAT(warnings[0], StartsWith(bad + ": damaged bytes at byte offset " +
-                                        std::to_string(second) + ".." + std::to_string(third)));
-    EXPECT_EQ(r->damaged_regions(), 1u);
-    ASSERT_EQ(r->chunks().size(), 4u);
-    EXPECT_EQ(r->find(w.frames[1]), nullptr);  // read as a dropped frame
-    EXPECT_NE(r->find(w.frames[0]), nullptr);
-    EXPECT_NE(r->find(w.frames[4]), nullptr);
-  }
-}
-
-TEST(BlobFile, HeaderErrorsAreOneLine) {
-  test::TempDir dir("blob_header");
-  std::mt19937_64 rng(5);
-  const std::string path = dir.file("h.blobs");
-  write_random(path, 2, rng);
-  const std::string good = test::read_file(path);
-  struct Case {
-    std::size_t at;
-    char value;
-    const char* needle;
-  };
-  const Case cases[] = {{0, 'X', "no \"MOCAPBLB\" magic"},
-                        {8, 2, "blob file version 2, this mocap reads version 1"},
-                        {12, 10, "blob record of 10 bytes"},
-                        {14, 9, "inconsistent sizes"},
-                        {33, 'A', "CRC mismatch"}};
-  for (const Case& c : cases) {
-    std::string bytes = good;
-    bytes[c.at] = c.value;
-    test::write_file(path, bytes);
-    std::vector<std::string> warnings;
-    auto r = BlobFileReader::open(path, warnings);
-    ASSERT_FALSE(r.ok()) << c.needle;
-    EXPECT_THAT(r.error().message, StartsWith(path + ": "));
-    EXPECT_THAT(r.error().message, HasSubstr(c.needle));
-    EXPECT_EQ(r.error().message.find('\n'), std::string::npos);
-  }
-  std::vector<std::string> warnings;
-  auto none = BlobFileReader::open(dir.file("none.blobs"), warnings);
-  ASSERT_FALSE(none.ok());
-  EXPECT_THAT(none.error().message, HasSubstr("cannot open"));
-}
-
-TEST(BlobFile, HostileBlobCountIsBoundedByTheHeader) {
-  test::TempDir dir("blob_hostile");
-  std::mt19937_64 rng(9);
-  const std::string path = dir.file("x.blobs");
-  write_random(path, 3, rng, 2);
-  std::string bytes = test::read_file(path);
-  const std::size_t first_chunk = 40;
-  for (int i = 0; i < 4; ++i) bytes[first_chunk + 4 + static_cast<std::size_t>(i)] = '\xff';
-  test::write_file(path, bytes);
-  std::vector<std::string> warnings;
-  auto r = BlobFileReader::open(path, warnings);
-  ASSERT_TRUE(r.ok());
-  EXPECT_EQ(r->chunks().size(), 2u);
-  ASSERT_EQ(warnings.size(), 1u);
-  EXPECT_THAT(warnings[0], HasSubstr("damaged bytes at byte offset 40.."));
 }
 
 TEST(BlobFile, WriterRefusesBadInputAndCutsAFailedWriteBack) {

@@ -56,6 +56,7 @@ TEST(EndToEnd, SimCamerasToUdpClientWithGroundTruthAndGapAccounting) {
   PipelineOptions opt = test::test_options();
   opt.max_frames = 150;
   opt.trigger_rate_hz = 200.0;
+  opt.catch_up_ns = 0;  // the newest frame first: the stalls drop frames (the gaps tested)
   auto p = Pipeline::create(rig.processor(), rig.cameras(), {&stall, &record, &udp_sink}, opt);
   ASSERT_TRUE(p.ok()) << p.error().message;
   ASSERT_TRUE((*p)->start().ok());

@@ -138,14 +138,16 @@ TEST(Pipeline, SlowSinkDropsAreCountedAndNothingIsPublishedTwice) {
 }
 
 // A sink that stalls 35 ms on every 10th message (3.5 frames at 100 frames/s, 3.5 ms per
-// message on average): the newest-first stages drop the frames the stall held back;
-// with every_frame (pipeline.every_frame) every frame is published, in order, later.
-std::uint64_t stalled_sink_run(bool every_frame, RecordingSink& sink, PipelineStats& st) {
+// message on average): the newest-first stages (catch_up_ns 0) drop the frames the stall
+// held back; with every_frame (pipeline.every_frame) every frame is published, in order,
+// later. With a catch-up bound (pipeline.catch_up_ms) the stages take the frames a stall
+// held back while they are younger than the bound, and skip the older ones.
+std::uint64_t stalled_sink_run(const PipelineOptions& base, RecordingSink& sink,
+                               PipelineStats& st) {
   SimRigFixture rig;
-  PipelineOptions opt = test::test_options();
+  PipelineOptions opt = base;
   opt.max_frames = 100;
   opt.trigger_rate_hz = 100.0;
-  opt.every_frame = every_frame;
   auto p = Pipeline::create(rig.processor(), rig.cameras(), {&sink}, opt);
   EXPECT_TRUE(p.ok());
   if (!p.ok()) return 0;
@@ -157,20 +159,44 @@ std::uint64_t stalled_sink_run(bool every_frame, RecordingSink& sink, PipelineSt
          counter(st, "detect0_skipped") + counter(st, "detect1_skipped");
 }
 
+// Every frame the stages received reached the sink, in order (a loaded test machine may
+// still drop at a full ring: counted, and then the sequence shows the gap).
+void expect_every_frame_in_order(const RecordingSink& sink, const PipelineStats& st) {
+  EXPECT_EQ(st.triggered, 100u);
+  const std::uint64_t ring_drops =
+      counter(st, "identify_no_slot") + counter(st, "frames_unpaired") +
+      counter(st, "capture_dropped_cam0") + counter(st, "capture_dropped_cam1");
+  EXPECT_EQ(sink.count() + ring_drops, 100u) << format_pipeline_stats(st);
+  for (std::size_t i = 1; i < sink.count(); ++i) EXPECT_GT(sink[i].sequence, sink[i - 1].sequence);
+}
+
 TEST(Pipeline, EveryFrameDelaysWhatAStallingSinkHeldBackAndLosesNothing) {
   RecordingSink newest_sink(1000, 35000, 10), ordered_sink(1000, 35000, 10);
   PipelineStats newest, ordered;
-  EXPECT_GT(stalled_sink_run(false, newest_sink, newest), 0u) << format_pipeline_stats(newest);
-  EXPECT_EQ(stalled_sink_run(true, ordered_sink, ordered), 0u) << format_pipeline_stats(ordered);
-  EXPECT_EQ(ordered.triggered, 100u);
-  // Every frame the stages received reached the sink, in order (a loaded test machine
-  // may still drop at a full ring: counted, and then the sequence shows the gap).
-  const std::uint64_t ring_drops =
-      counter(ordered, "identify_no_slot") + counter(ordered, "frames_unpaired") +
-      counter(ordered, "capture_dropped_cam0") + counter(ordered, "capture_dropped_cam1");
-  EXPECT_EQ(ordered_sink.count() + ring_drops, 100u) << format_pipeline_stats(ordered);
-  for (std::size_t i = 1; i < ordered_sink.count(); ++i)
-    EXPECT_GT(ordered_sink[i].sequence, ordered_sink[i - 1].sequence);
+  PipelineOptions opt = test::test_options();
+  opt.catch_up_ns = 0;
+  EXPECT_GT(stalled_sink_run(opt, newest_sink, newest), 0u) << format_pipeline_stats(newest);
+  opt.every_frame = true;
+  EXPECT_EQ(stalled_sink_run(opt, ordered_sink, ordered), 0u) << format_pipeline_stats(ordered);
+  expect_every_frame_in_order(ordered_sink, ordered);
+}
+
+TEST(Pipeline, CatchUpTakesWhatAShortStallHeldBackAndSkipsWhatALongOneMadeStale) {
+  // Stalls of 35 ms against a bound of 500 ms: nothing is too old, nothing is skipped.
+  RecordingSink short_sink(1000, 35000, 10);
+  PipelineStats short_st;
+  PipelineOptions opt = test::test_options();
+  opt.catch_up_ns = 500'000'000;
+  EXPECT_EQ(stalled_sink_run(opt, short_sink, short_st), 0u) << format_pipeline_stats(short_st);
+  expect_every_frame_in_order(short_sink, short_st);
+  // Stalls of 200 ms against a bound of 20 ms: the frames they held back are stale.
+  RecordingSink long_sink(1000, 200000, 25);
+  PipelineStats long_st;
+  opt.catch_up_ns = 20'000'000;
+  EXPECT_GT(stalled_sink_run(opt, long_sink, long_st), 0u) << format_pipeline_stats(long_st);
+  EXPECT_LT(long_sink.count(), 100u);
+  for (std::size_t i = 1; i < long_sink.count(); ++i)
+    EXPECT_GT(long_sink[i].sequence, long_sink[i - 1].sequence);
 }
 
 TEST(Pipeline, StartStopRepeatedly) {

@@ -104,6 +104,33 @@ TEST(SlotPool, PopLatestSkipsAndRecyclesOlderFrames) {
   EXPECT_EQ(pool->skipped(), 3u);
 }
 
+TEST(SlotPool, PopFreshTakesTheOldestFreshSlotInOrderAndSkipsOnlyStaleOnes) {
+  auto pool = make_pool(8);
+  ASSERT_TRUE(pool.ok());
+  SlotHandle h;
+  for (std::uint64_t seq = 0; seq < 5; ++seq) {
+    ASSERT_TRUE(pool->acquire(h));
+    (*pool)[h].sequence = seq;
+    pool->publish(h);
+  }
+  // "Fresh": sequence >= 2. 0 and 1 are stale and skipped; 2, 3, 4 come in order.
+  const auto fresh = [](const FrameSlot& s) { return s.sequence >= 2; };
+  for (std::uint64_t want = 2; want < 5; ++want) {
+    ASSERT_TRUE(pool->pop_fresh(h, fresh));
+    EXPECT_EQ((*pool)[h].sequence, want);
+    pool->release(h);
+  }
+  EXPECT_EQ(pool->skipped(), 2u);
+  EXPECT_FALSE(pool->pop_fresh(h, fresh));
+  // A stale slot with nothing newer is still taken: the newest is never skipped.
+  ASSERT_TRUE(pool->acquire(h));
+  (*pool)[h].sequence = 0;
+  pool->publish(h);
+  ASSERT_TRUE(pool->pop_fresh(h, fresh));
+  EXPECT_EQ((*pool)[h].sequence, 0u);
+  EXPECT_EQ(pool->skipped(), 2u);
+}
+
 TEST(SlotPool, ProducerDropsWhenConsumerHoldsEverything) {
   auto pool = make_pool(2);
   ASSERT_TRUE(pool.ok());

@@ -277,7 +277,8 @@ TEST(ServiceProcess, CheckConfigRejectsWithOneLine) {
   EXPECT_EQ(r.output, "mocap: " + dir.file("bad.yaml") +
                           ": pipeline.trigger_rate: unknown key (line 2); expected one of: "
                           "trigger_rate_hz, pacing, realtime, lock_memory, cpu_latency_us, "
-                          "dequeue_timeout_ms, stages, pair_by, pair_tolerance_us, every_frame\n");
+                          "dequeue_timeout_ms, stages, pair_by, pair_tolerance_us, every_frame, "
+                          "catch_up_ms\n");
 }
 
 TEST(ServiceProcess, RunWithABadConfigFailsBeforeStarting) {

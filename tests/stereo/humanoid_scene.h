@@ -3,7 +3,8 @@
 // working volume, and random frames of markers in that volume with 0.1 px centroid noise,
 // views missing at random (occlusion) or hidden by the body (markers on its surface),
 // stray blobs and, optionally, split blobs (two
-// blobs close together where one marker was expected) and exact duplicate blobs.
+// blobs close together where one marker was expected) and exact duplicate blobs. The
+// property tests draw their many scenes with random_ring_rig() and random_scene().
 #pragma once
 
 #include <algorithm>
@@ -64,6 +65,28 @@ struct SceneOptions {
   // its tangent plane, a convex body's occlusion; 180: every camera).
   double facing_deg = 180.0;
 };
+
+// A property test's random ring: `cameras` cameras 2.5-3.5 m from the volume, each
+// jittered by up to 15 degrees on the ring.
+inline Rig random_ring_rig(int cameras, std::mt19937& rng) {
+  RingOptions ro;
+  ro.cameras = cameras;
+  ro.radius_mm = 2500.0 + 1000.0 * std::uniform_real_distribution<double>(0.0, 1.0)(rng);
+  ro.jitter_deg = 15.0;
+  return humanoid_ring_rig(ro, rng);
+}
+
+// A property test's random scene: 5..max_markers markers, 0..max_strays strays per
+// camera, each view missed with a probability up to max_hidden; the other options at
+// their defaults (the test sets the corner cases it mixes in).
+inline SceneOptions random_scene(int max_markers, int max_strays, double max_hidden,
+                                 std::mt19937& rng) {
+  SceneOptions so;
+  so.markers = 5 + static_cast<int>(rng() % static_cast<unsigned>(max_markers - 4));
+  so.strays = static_cast<int>(rng() % static_cast<unsigned>(max_strays + 1));
+  so.hidden = max_hidden * std::uniform_real_distribution<double>(0.0, 1.0)(rng);
+  return so;
+}
 
 // One frame: per camera, the blobs (shuffled). markers_world (optional) receives every
 // marker's position, the second balls of twins included.

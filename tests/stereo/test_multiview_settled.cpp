@@ -57,16 +57,10 @@ TEST(MultiViewSettled, FindsEveryMarkerTheReferenceFindsOnRandomScenesWithCorner
   std::uint64_t skipped = 0, hypotheses_reference = 0;
   MultiViewCounters total;
   for (int s = 0; s < 240; ++s) {
-    test::RingOptions ro;
-    ro.cameras = 3 + s % 6;
-    ro.radius_mm = 2500.0 + 1000.0 * std::uniform_real_distribution<double>(0.0, 1.0)(rng);
-    ro.jitter_deg = 15.0;
-    const Rig rig = test::humanoid_ring_rig(ro, rng);
-    test::SceneOptions so;
+    const int cameras = 3 + s % 6;
+    const Rig rig = test::random_ring_rig(cameras, rng);
+    test::SceneOptions so = test::random_scene(150, 8, 0.3, rng);
     std::uniform_real_distribution<double> u01(0.0, 1.0);
-    so.markers = 5 + static_cast<int>(rng() % 146);
-    so.strays = static_cast<int>(rng() % 9);
-    so.hidden = 0.3 * u01(rng);
     so.split = s % 4 == 0 ? 0.0 : 0.08 * u01(rng);
     so.duplicate = s % 5 == 1 ? 0.03 : 0.0;
     so.shifted = s % 3 == 0 ? 0.0 : 0.15 * u01(rng);
@@ -78,7 +72,7 @@ TEST(MultiViewSettled, FindsEveryMarkerTheReferenceFindsOnRandomScenesWithCorner
       const auto px = test::humanoid_frame(rig, so, rng, &markers);
       settled.run(px);
       reference.run(px);
-      SCOPED_TRACE(::testing::Message() << "scene " << s << " frame " << f << ", " << ro.cameras
+      SCOPED_TRACE(::testing::Message() << "scene " << s << " frame " << f << ", " << cameras
                                         << " cameras, " << so.markers << " markers");
       for (const Vec3& X : markers) {
         const int r = settled_nearest_reported(reference.out, X, 1.0);

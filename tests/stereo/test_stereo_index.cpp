@@ -70,15 +70,9 @@ TEST(StereoIndex, IndexedPathEqualsThePreviousAndTheBruteForceOnRandomScenes) {
   std::mt19937 rng(20261204);
   int scenes = 0, points = 0, multi = 0, brute_compared = 0;
   for (int s = 0; s < 120; ++s) {
-    test::RingOptions ro;
-    ro.cameras = 2 + s % 7;
-    ro.radius_mm = 2500.0 + 1000.0 * std::uniform_real_distribution<double>(0.0, 1.0)(rng);
-    ro.jitter_deg = 15.0;
-    const Rig rig = test::humanoid_ring_rig(ro, rng);
-    test::SceneOptions so;
-    so.markers = 5 + static_cast<int>(rng() % 126);
-    so.strays = static_cast<int>(rng() % 7);
-    so.hidden = 0.25 * std::uniform_real_distribution<double>(0.0, 1.0)(rng);
+    const int cameras = 2 + s % 7;
+    const Rig rig = test::random_ring_rig(cameras, rng);
+    test::SceneOptions so = test::random_scene(130, 6, 0.25, rng);
     so.split = 0.05;
     // Exact duplicate blobs (every third scene) tie hypotheses exactly; the merge breaks
     // such ties by hypothesis order, which follows the pairs' candidate order (the sorted
@@ -93,7 +87,7 @@ TEST(StereoIndex, IndexedPathEqualsThePreviousAndTheBruteForceOnRandomScenes) {
       previous.run(px);
       brute.run(px);
       pair_undistort.run(px);
-      SCOPED_TRACE(::testing::Message() << "scene " << s << " frame " << f << ", " << ro.cameras
+      SCOPED_TRACE(::testing::Message() << "scene " << s << " frame " << f << ", " << cameras
                                         << " cameras, " << so.markers << " markers");
       std::uint64_t skipped = 0;  // settled pairs the fresh path's pairs did not try
       for (std::size_t k = 0; k < fresh.pairs.size(); ++k) {

@@ -21,6 +21,8 @@
 //     per client (more: disconnected, flooding); the session (vrpn_session.h) parses
 //     them; a protocol violation or no cookie within handshake_ms disconnects
 //     (protocol_errors).
+// Implementation: vrpn_server.cpp (the listening side and the poll loop), vrpn_client.cpp
+// (one client's connection), their shared state in vrpn_server_impl.h.
 #pragma once
 
 #include <atomic>
