@@ -12,9 +12,11 @@
 // kConfigured; any fatal device failure (device unplugged, unrecoverable I/O) moves
 // to kError, where hot calls return kDeviceLost and only stop()/destruction are valid.
 // Hot-path calls return a CameraStatus and count failures in CameraCounters (single
-// writer: the capture thread; readable from any thread). A camera object is driven by
-// ONE thread (the capture thread); other stages reach its buffers through rings and
-// hand them back to that thread for release().
+// writer: the thread driving the camera; readable from any thread). A camera object is
+// driven by ONE thread at a time (the capture thread; on a camera node, the detection
+// worker that holds it, hand-overs ordered by release/acquire: pipeline/node/
+// node_runner.h); other stages reach its buffers through rings and hand them back to that
+// thread for release().
 // Backends that own their state derive from CameraBase (hal/camera_base.h), which keeps
 // name/state/config/notice/counters and the sequence-gap counting for them.
 #pragma once

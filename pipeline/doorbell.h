@@ -27,12 +27,13 @@ class Doorbell {
     return count_.load(std::memory_order_acquire);
   }
 
-  // Any producer.
-  void ring() noexcept {
+  // Any producer. Wakes up to `wake` waiters (several consumers sharing the bell: a pool
+  // of workers).
+  void ring(int wake = 1) noexcept {
     // seq_cst (with the seq_cst waiter registration): Dekker-style, see the comment above.
     count_.fetch_add(1, std::memory_order_seq_cst);
     if (waiters_.load(std::memory_order_seq_cst) > 0) {
-      syscall(SYS_futex, raw(), FUTEX_WAKE_PRIVATE, 1, nullptr, nullptr, 0);
+      syscall(SYS_futex, raw(), FUTEX_WAKE_PRIVATE, wake, nullptr, nullptr, 0);
     }
   }
 

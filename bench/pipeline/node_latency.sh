@@ -13,10 +13,14 @@
 # the node's replay and detection, the blob message's way back and the central's hand-over
 # of the blobs instead of the detection. The central's report also splits (b) into its
 # legs (`node_trigger_leg`, `node_work`, `node_transit`).
-# Usage: bash bench/pipeline/node_latency.sh [MOCAP] REC [OUT] [RUNS] [REALTIME]
+# Usage: bash bench/pipeline/node_latency.sh [MOCAP] REC [OUT] [RUNS] [REALTIME] [DETECT]
 #   REC: an 8-camera recording with targets.yaml and gt/model_true.yaml, e.g.
 #        `mocap simulate --scene humanoid --cameras 8 --frames 200 --out REC`;
-#   defaults: build/mocap, -, /tmp/node_latency, 3 runs, realtime false.
+#   DETECT: each node's node.detect_threads, or `default` (min(4, CPUs)); 1 by default:
+#        two nodes sharing this PC's cores split them as a lab splits a shared PC
+#        (docs/operations.md), and (b) detects as (a) does: 4 cameras after one another on
+#        each of the 2 cores;
+#   defaults: build/mocap, -, /tmp/node_latency, 3 runs, realtime false, 1.
 # docs/performance.md records the figures with the machine.
 set -euo pipefail
 mocap=$(realpath "${1:-build/mocap}")
@@ -24,6 +28,8 @@ rec=$(realpath "$2")
 out=${3:-/tmp/node_latency}
 runs=${4:-3}
 realtime=${5:-false}
+detect=${6:-1}
+workers=$([ "$detect" = default ] || echo ", detect_threads: $detect")
 domain=$((100 + $$ % 100))
 mkdir -p "$out"
 rm -f "$out/added.txt"
@@ -41,7 +47,8 @@ tracker_keys() {
 } >"$out/single.yaml"
 for n in 0 1; do
   {
-    printf 'node: {name: n%s, domain_id: %s}\npipeline: {realtime: %s}\ncameras:\n' "$n" "$domain" "$realtime"
+    printf 'node: {name: n%s, domain_id: %s%s}\npipeline: {realtime: %s}\ncameras:\n' "$n" "$domain" \
+      "$workers" "$realtime"
     for c in $((4 * n)) $((4 * n + 1)) $((4 * n + 2)) $((4 * n + 3)); do
       echo "  - {backend: replay, device: $rec, camera: cam$c, trigger: central}"
     done

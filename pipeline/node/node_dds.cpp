@@ -30,25 +30,32 @@ Expected<dds_entity_t> check(dds_entity_t e, const std::string& who, const char*
   return e;
 }
 
-// The user's configuration (CYCLONEDDS_URI: files and/or XML, comma-separated), then one
-// receive thread at SCHED_FIFO kDdsFifoPriority.
-std::string realtime_config() {
+// The user's configuration (CYCLONEDDS_URI: files and/or XML, comma-separated), then,
+// when realtime, one receive thread at SCHED_FIFO kDdsFifoPriority, and when batching,
+// Internal/WriteBatch.
+std::string domain_config(bool realtime, bool batch_writes) {
   std::string c;
   if (const char* uri = std::getenv("CYCLONEDDS_URI"); uri != nullptr && uri[0] != '\0')
     c = std::string(uri) + ",";
-  return c + "<Internal><MultipleReceiveThreads>false</MultipleReceiveThreads></Internal>" +
-         "<Threads><Thread name=\"recv\"><Scheduling><Class>realtime</Class><Priority>" +
-         std::to_string(kDdsFifoPriority) + "</Priority></Scheduling></Thread></Threads>";
+  if (realtime)
+    c +=
+        std::string("<Internal><MultipleReceiveThreads>false</MultipleReceiveThreads></Internal>") +
+        "<Threads><Thread name=\"recv\"><Scheduling><Class>realtime</Class><Priority>" +
+        std::to_string(kDdsFifoPriority) + "</Priority></Scheduling></Thread></Threads>";
+  if (batch_writes) c += "<Internal><WriteBatch>true</WriteBatch></Internal>";
+  return c;
 }
 
 }  // namespace
 
 Expected<NodeDomain> NodeDomain::open(std::uint32_t domain_id, const std::string& who,
-                                      bool realtime) {
+                                      bool realtime, bool batch_writes) {
   if (domain_id > 232) return make_error(who, "node.domain_id", "must be in 0..232");
   NodeDomain d;
   const dds_entity_t dom =
-      realtime ? dds_create_domain(domain_id, realtime_config().c_str()) : dds_entity_t{0};
+      realtime || batch_writes
+          ? dds_create_domain(domain_id, domain_config(realtime, batch_writes).c_str())
+          : dds_entity_t{0};
   // PRECONDITION_NOT_MET: this process has the domain already (joined below as it is).
   if (dom < 0 && dom != DDS_RETCODE_PRECONDITION_NOT_MET)
     return make_error(who, "dds_create_domain", std::string("DDS: ") + dds_strretcode(dom));

@@ -9,13 +9,17 @@
 // Real-time (`pipeline.realtime`, the default): the participant's domain is created with
 // ONE Cyclone receive thread (`recv`; Internal/MultipleReceiveThreads false) at SCHED_FIFO
 // kDdsFifoPriority, after the user's CYCLONEDDS_URI (which still applies otherwise), and
-// the DDS-side threads of node_sender.h and node_link.h run at the same priority: above
-// the camera and capture threads (80), so a message or trigger never waits for a
+// the central's trigger writer (node_link.h) runs at the same priority: above the camera,
+// capture and detection threads (80), so a message or trigger never waits for a
 // detection to finish (default-policy threads waited milliseconds on a busy PC; docs/
-// performance.md). Without the privilege Cyclone starts the thread with the default policy
-// and the camera threads' notes say so. A domain this process already created (another
-// NodeDomain, the ROS 2 output) is joined as it is.
-// Setup functions allocate and return one-line errors; the sample copies are noexcept.
+// performance.md). The node's sender (node_sender.h) runs at kSenderFifoPriority, below
+// its detection threads: it writes a pass's messages when a core is free of detection,
+// never preempting one (above them it delayed the other node's detections on shared cores). Without
+// the privilege Cyclone starts the thread with the default policy and the camera threads' notes say
+// so. A domain this process already created (another NodeDomain, the ROS 2 output) is joined as it
+// is. The node's domain batches its writes (NodeDomain::open, batch_writes): its sender flushes
+// after the messages ready at once. Setup functions allocate and return one-line errors; the sample
+// copies are noexcept.
 #pragma once
 
 #include <dds/dds.h>
@@ -32,14 +36,19 @@ namespace mocap::node {
 inline constexpr const char* kBlobTopic = "mocap/blobs";
 inline constexpr const char* kTriggerTopic = "mocap/trigger";
 inline constexpr int kHistoryDepth = 32;
-inline constexpr int kDdsFifoPriority = 85;  // Cyclone's receive thread and ours (realtime)
+inline constexpr int kDdsFifoPriority = 85;     // Cyclone's receive thread and ours (realtime)
+inline constexpr int kSenderFifoPriority = 75;  // the node's sender: below its detection (80)
 
 // The participant and both topics; participant <= 0 when not open. Owns the participant
 // (deleting it deletes every entity created under it) and, once its last participant is
 // gone, the domain it created.
 class NodeDomain {
  public:
-  static Expected<NodeDomain> open(std::uint32_t domain_id, const std::string& who, bool realtime);
+  // batch_writes: the domain this process creates batches its writes (Cyclone's
+  // Internal/WriteBatch): a write is sent at the writer's next dds_write_flush(), so the
+  // messages written together leave in as few datagrams as fit (the node's sender).
+  static Expected<NodeDomain> open(std::uint32_t domain_id, const std::string& who, bool realtime,
+                                   bool batch_writes = false);
   NodeDomain() = default;
   NodeDomain(NodeDomain&& o) noexcept { *this = static_cast<NodeDomain&&>(o); }
   NodeDomain& operator=(NodeDomain&& o) noexcept;

@@ -1,6 +1,8 @@
 // Design: see node_runner.h.
 #include "pipeline/node/node_runner.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cstdio>
 
@@ -23,7 +25,19 @@ Expected<std::unique_ptr<NodeRunner>> NodeRunner::create(std::vector<NodeCameraS
         "at most " + std::to_string(kMaxBlobsPerMessage) + " on a node (one message)");
   if (!(options.trigger_rate_hz > 0.0))
     return make_error("mocap node", "pipeline.trigger_rate_hz", "must be > 0");
+  int central = 0;
+  for (const NodeCameraSpec& s : cameras) central += s.central ? 1 : 0;
+  if (options.detect_threads < 0 || options.detect_threads > central)
+    return make_error("mocap node", "node.detect_threads",
+                      std::to_string(options.detect_threads) + " workers for " +
+                          std::to_string(central) + " cameras with trigger: central");
   std::unique_ptr<NodeRunner> r(new NodeRunner(std::move(cameras), options, sender));
+  for (int c = 0; c < n; ++c)
+    if (r->cams_[static_cast<std::size_t>(c)].central) r->central_.push_back(c);
+  const long cpus = sysconf(_SC_NPROCESSORS_ONLN);
+  r->workers_ =
+      detect_workers(options.detect_threads, central, cpus > 0 ? static_cast<int>(cpus) : 1);
+  sender.set_trigger_wakeups(r->workers_);
   for (const NodeCameraSpec& s : r->cams_) {
     if (s.camera == nullptr) return make_error("mocap node", "cameras", "camera missing");
     const hal::CameraConfig& cc = s.camera->config();
@@ -43,6 +57,12 @@ Expected<std::unique_ptr<NodeRunner>> NodeRunner::create(std::vector<NodeCameraS
   return r;
 }
 
+int detect_workers(int detect_threads, int central, int cpus) noexcept {
+  if (central <= 0) return 0;
+  if (detect_threads > 0) return std::min(detect_threads, central);
+  return std::clamp(cpus, 1, central);
+}
+
 NodeRunner::~NodeRunner() { stop(); }
 
 Expected<void> NodeRunner::start() {
@@ -56,10 +76,20 @@ Expected<void> NodeRunner::start() {
       return r.error();
     }
   }
+  for (auto& s : states_) {
+    s->ended = false;
+    s->held.store(false, std::memory_order_relaxed);  // no thread runs yet
+  }
   running_ = true;
-  for (int c = 0; c < static_cast<int>(cams_.size()); ++c) {
-    rt::ThreadSpec spec{"mocap-node" + std::to_string(c), -1, options_.realtime ? 80 : 0};
-    auto t = rt::start_thread(spec, [this, c] { run(c); });
+  const int cameras = static_cast<int>(cams_.size());
+  for (int k = 0; k < cameras + workers_; ++k) {
+    const bool worker = k >= cameras;
+    if (!worker && cams_[static_cast<std::size_t>(k)].central) continue;  // a worker's
+    const std::string name =
+        worker ? "mocap-ndet" + std::to_string(k - cameras) : "mocap-node" + std::to_string(k);
+    rt::ThreadSpec spec{name, -1, options_.realtime ? 80 : 0};
+    auto t = worker ? rt::start_thread(spec, [this] { work(); })
+                    : rt::start_thread(spec, [this, k] { run(k); });
     if (!t) {
       stop();
       return t.error();
@@ -72,9 +102,9 @@ Expected<void> NodeRunner::start() {
 
 void NodeRunner::stop() noexcept {
   if (!running_) return;
-  // release: the camera threads' acquire loads see the stop.
+  // release: the camera threads' and workers' acquire loads see the stop.
   stop_.store(true, std::memory_order_release);
-  for (std::size_t c = 0; c < cams_.size(); ++c) sender_.trigger_bell(static_cast<int>(c)).ring();
+  sender_.trigger_bell().ring(std::max(workers_, 1));
   for (rt::RtThread& t : threads_) {
     if (t.joinable()) t.join();
   }
@@ -151,36 +181,104 @@ void NodeRunner::send(int c, const hal::Frame* f, std::uint16_t flags,
   h.noise_dn = lv.noise_dn;
   h.threshold_dn = lv.threshold_dn;
   h.blob_count = image ? encode_blobs(list, w.blobs, sizeof w.blobs) : 0;
-  sender_.queue(c).push(w);  // drop-oldest: counted in the queue's dropped()
-  sender_.wake();
+  sender_.queue(c).push(w);  // drop-oldest: counted in the queue's dropped(); woken by the caller
+}
+
+bool NodeRunner::deliver(int c, hal::CameraStatus s, hal::Frame& f) noexcept {
+  const auto ci = static_cast<std::size_t>(c);
+  CamState& st = state(c);
+  if (s == hal::CameraStatus::kTimeout || s == hal::CameraStatus::kAgain) {
+    if (s == hal::CameraStatus::kTimeout) st.timeouts.add();
+    return false;
+  }
+  if (s == hal::CameraStatus::kEndOfStream) {
+    send(c, nullptr, kWireEndOfStream, TriggerStamp{});
+    st.ended = true;
+    ended_.fetch_add(1, std::memory_order_acq_rel);  // finished() acquires it
+    return true;
+  }
+  if (s != hal::CameraStatus::kOk) {
+    st.errors.add();
+    return false;
+  }
+  TriggerStamp t{f.sequence, 0, 0};
+  if (cams_[ci].central && st.count > 0) {
+    t = st.pending[st.head];
+    st.head = (st.head + 1) % static_cast<std::uint32_t>(std::size(st.pending));
+    --st.count;
+    st.behind_noted = false;
+  }
+  st.frames.add();
+  send(c, &f, 0, t);
+  if (cams_[ci].camera->release(f) != hal::CameraStatus::kOk) st.errors.add();
+  return false;
+}
+
+bool NodeRunner::claim(int c) noexcept {
+  std::atomic<bool>& held = state(c).held;
+  // relaxed pre-check: a held camera is skipped without writing its line; acquire on the
+  // exchange: the previous holder's writes (camera, state, queue) happen before ours.
+  return !held.load(std::memory_order_relaxed) && !held.exchange(true, std::memory_order_acquire);
+}
+
+void NodeRunner::unclaim(int c) noexcept {
+  // release: this holder's writes happen before the next holder's acquire exchange.
+  state(c).held.store(false, std::memory_order_release);
+}
+
+bool NodeRunner::play(int c) noexcept {
+  const auto ci = static_cast<std::size_t>(c);
+  CamState& st = state(c);
+  take_triggers(c);
+  if (st.count == 0) return false;
+  // A replay plays the frame the oldest pending trigger names (a no-op in step).
+  if (hal::ReplayCamera* r = cams_[ci].seekable;
+      r != nullptr && r->seek(st.pending[st.head].number) == hal::CameraStatus::kUnsupported &&
+      !st.behind_noted) {
+    st.behind.add();  // once per trigger
+    st.behind_noted = true;
+  }
+  hal::Frame f;
+  (void)deliver(c, cams_[ci].camera->dequeue(f, 20), f);
+  return true;
+}
+
+void NodeRunner::work() noexcept {
+  pipeline::Doorbell& bell = sender_.trigger_bell();
+  while (!stop_.load(std::memory_order_acquire)) {
+    const std::uint32_t seen = bell.snapshot();
+    // Every pending trigger first (the exposures start together), then one frame per
+    // camera; a camera held by another worker is that worker's.
+    // The camera's state (ended included) is read and written only by its holder.
+    for (const int c : central_) {
+      if (!claim(c)) continue;
+      if (!state(c).ended) take_triggers(c);
+      unclaim(c);
+    }
+    bool played = false;
+    for (const int c : central_) {
+      if (!claim(c)) continue;
+      if (!state(c).ended) played = play(c) || played;
+      unclaim(c);
+    }
+    // One wake-up of the sender for the frames of this pass: it writes them together.
+    if (played)
+      sender_.wake();
+    else
+      bell.wait(seen, 10'000'000);
+  }
 }
 
 void NodeRunner::run(int c) noexcept {
   const auto ci = static_cast<std::size_t>(c);
   hal::Camera& cam = *cams_[ci].camera;
-  CamState& st = *states_[ci];
-  const bool central = cams_[ci].central;
-  const bool software = !central && cam.config().trigger == hal::TriggerMode::kSoftware;
+  CamState& st = state(c);
+  const bool software = cam.config().trigger == hal::TriggerMode::kSoftware;
   const auto period_ns = static_cast<std::int64_t>(1e9 / options_.trigger_rate_hz);
   std::int64_t next_ns = monotonic_ns();
-  pipeline::Doorbell& bell = sender_.trigger_bell(c);
   while (!stop_.load(std::memory_order_acquire)) {
     int timeout_ms = 20;
-    if (central) {
-      const std::uint32_t seen = bell.snapshot();
-      take_triggers(c);
-      if (st.count == 0) {  // nothing released: wait for the next central trigger
-        bell.wait(seen, 10'000'000);
-        continue;
-      }
-      // A replay plays the frame the oldest pending trigger names (a no-op in step).
-      if (hal::ReplayCamera* r = cams_[ci].seekable;
-          r != nullptr && r->seek(st.pending[st.head].number) == hal::CameraStatus::kUnsupported &&
-          !st.behind_noted) {
-        st.behind.add();  // once per trigger
-        st.behind_noted = true;
-      }
-    } else if (software) {
+    if (software) {
       const std::int64_t now = monotonic_ns();
       if (now >= next_ns) {
         if (cam.trigger() != hal::CameraStatus::kOk) st.errors.add();
@@ -193,29 +291,9 @@ void NodeRunner::run(int c) noexcept {
     }
     hal::Frame f;
     const hal::CameraStatus s = cam.dequeue(f, timeout_ms);
-    if (s == hal::CameraStatus::kTimeout || s == hal::CameraStatus::kAgain) {
-      if (s == hal::CameraStatus::kTimeout) st.timeouts.add();
-      continue;
-    }
-    if (s == hal::CameraStatus::kEndOfStream) {
-      send(c, nullptr, kWireEndOfStream, TriggerStamp{});
-      ended_.fetch_add(1, std::memory_order_acq_rel);  // finished() acquires it
-      break;
-    }
-    if (s != hal::CameraStatus::kOk) {
-      st.errors.add();
-      continue;
-    }
-    TriggerStamp t{f.sequence, 0, 0};
-    if (central && st.count > 0) {
-      t = st.pending[st.head];
-      st.head = (st.head + 1) % static_cast<std::uint32_t>(std::size(st.pending));
-      --st.count;
-      st.behind_noted = false;
-    }
-    st.frames.add();
-    send(c, &f, 0, t);
-    if (cam.release(f) != hal::CameraStatus::kOk) st.errors.add();
+    const bool ended = deliver(c, s, f);
+    if (s == hal::CameraStatus::kOk || ended) sender_.wake();  // a message was pushed
+    if (ended) break;
   }
 }
 

@@ -12,7 +12,7 @@ Expected<std::unique_ptr<NodeSender>> NodeSender::create(std::uint32_t domain_id
   if (n < 1 || n > kMaxNodeCameras)
     return make_error("mocap node", "cameras", "1.." + std::to_string(kMaxNodeCameras));
   std::unique_ptr<NodeSender> s(new NodeSender());
-  auto d = NodeDomain::open(domain_id, "mocap node", realtime);
+  auto d = NodeDomain::open(domain_id, "mocap node", realtime, true);  // batched: send_pending
   if (!d) return d.error();
   s->domain_ = std::move(d).value();
   auto w = s->domain_.writer(s->domain_.blob_topic(), "mocap node: mocap/blobs");
@@ -23,7 +23,6 @@ Expected<std::unique_ptr<NodeSender>> NodeSender::create(std::uint32_t domain_id
   s->trigger_reader_ = *r;
   s->central_ = central;
   s->realtime_ = realtime;
-  s->trigger_bells_ = std::make_unique<pipeline::Doorbell[]>(static_cast<std::size_t>(n));
   for (int c = 0; c < n; ++c) {
     auto q = rt::DropOldestQueue<WireFrame>::create(queue_depth);
     if (!q) return q.error();
@@ -40,7 +39,7 @@ NodeSender::~NodeSender() { stop(false); }
 Expected<void> NodeSender::start() {
   stop_.store(false, std::memory_order_relaxed);  // no thread runs yet
   notes_.clear();
-  const int priority = realtime_ ? kDdsFifoPriority : 0;
+  const int priority = realtime_ ? kSenderFifoPriority : 0;
   auto a = rt::start_thread(rt::ThreadSpec{"mocap-nsend", -1, priority}, [this] { send_loop(); });
   if (!a) return a.error();
   send_thread_ = std::move(a).value();
@@ -98,6 +97,9 @@ bool NodeSender::send_pending() noexcept {
       any = true;
     }
   }
+  // The domain batches the writes (NodeDomain::open): what was written leaves now,
+  // together, in as few datagrams as fit (one per node and trigger on loopback).
+  if (any) dds_write_flush(writer_);
   return any;
 }
 
@@ -132,10 +134,8 @@ void NodeSender::take_triggers(dds_entity_t reader) noexcept {
     }
     (void)dds_return_loan(reader, samples, n);
     samples[0] = nullptr;  // the next take loans again
-    // Every camera's trigger first, then the wake-ups: a woken camera thread never delays
-    // the next camera's trigger.
-    for (std::size_t c = 0; c < central_.size(); ++c)
-      if (central_[c]) trigger_bells_[c].ring();
+    // Every camera's trigger first, then one ring: a woken worker finds them all.
+    trigger_bell_.ring(trigger_wakeups_);
   }
 }
 

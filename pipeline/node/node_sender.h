@@ -1,14 +1,19 @@
 // Design: the DDS side of `mocap node` (issue 29), between the node's camera threads
 // (node_runner.h) and the network:
-//   - the sender thread (`mocap-nsend`, SCHED_FIFO kDdsFifoPriority when realtime): takes
+//   - the sender thread (`mocap-nsend`, SCHED_FIFO kSenderFifoPriority when realtime, below
+//     the detection threads, so a write never preempts a detection in progress): takes
 //     every camera's messages from its bounded drop-oldest queue (rt::DropOldestQueue<
-//     WireFrame>, one per camera: one producer each; drops are counted and reported in the
-//     camera's health), stamps sent_ns and writes them to mocap/blobs. The camera threads
-//     never touch DDS (it locks and allocates).
+//     WireFrame>, one per camera: one producer at a time; drops are counted and reported in
+//     the camera's health), stamps sent_ns and writes them to mocap/blobs, every message
+//     ready at its wake-up, then flushes them together (the node's domain batches writes:
+//     a detection worker wakes the sender once per pass over its cameras, so a node's
+//     messages of one trigger leave in one go). The camera and detection threads never
+//     touch DDS (it locks and allocates).
 //   - the mocap/trigger listener, called by Cyclone where it delivers a trigger (its
 //     receive thread, real-time too: node_dds.h), so no thread hop: hands each trigger
 //     (number, central send time, node receive time) to every camera with `trigger:
-//     central` through its SPSC ring, then rings the cameras' doorbells (after every push).
+//     central` through its SPSC ring, then rings the detection workers' one doorbell
+//     (after every camera's push), waking up to set_trigger_wakeups() of them.
 // Setup allocates (queues of depth x 139 KiB per camera); the camera-thread side
 // (queue push, trigger ring pop, doorbells) is noexcept, lock-free and allocation-free.
 #pragma once
@@ -37,7 +42,8 @@ struct TriggerStamp {
 class NodeSender {
  public:
   // central[c]: camera c follows the central triggers. queue_depth: messages per camera.
-  // realtime: both threads and Cyclone's receive thread at SCHED_FIFO kDdsFifoPriority.
+  // realtime: Cyclone's receive thread (the trigger listener) at SCHED_FIFO
+  // kDdsFifoPriority, the sender thread at kSenderFifoPriority.
   static Expected<std::unique_ptr<NodeSender>> create(std::uint32_t domain_id,
                                                       const std::vector<bool>& central,
                                                       int queue_depth, bool realtime);
@@ -53,7 +59,10 @@ class NodeSender {
   rt::DropOldestQueue<WireFrame>& queue(int c) noexcept { return *queues_[idx(c)]; }
   void wake() noexcept { bell_.ring(); }
   rt::SpscRing<TriggerStamp>& triggers(int c) noexcept { return *triggers_[idx(c)]; }
-  pipeline::Doorbell& trigger_bell(int c) noexcept { return trigger_bells_[idx(c)]; }
+  // The detection workers' doorbell (node_runner.h): rung after each trigger's pushes.
+  pipeline::Doorbell& trigger_bell() noexcept { return trigger_bell_; }
+  // Setup, before start(): how many workers a trigger wakes (the workers sharing the bell).
+  void set_trigger_wakeups(int workers) noexcept { trigger_wakeups_ = workers; }
 
   // Any thread.
   std::uint64_t sent() const noexcept { return sent_.get(); }
@@ -79,7 +88,8 @@ class NodeSender {
   std::vector<std::string> notes_;
   std::vector<std::unique_ptr<rt::DropOldestQueue<WireFrame>>> queues_;
   std::vector<std::unique_ptr<rt::SpscRing<TriggerStamp>>> triggers_;
-  std::unique_ptr<pipeline::Doorbell[]> trigger_bells_;
+  pipeline::Doorbell trigger_bell_;
+  int trigger_wakeups_ = 1;
   pipeline::Doorbell bell_;
   std::atomic<bool> stop_{false};
   rt::RtThread send_thread_;

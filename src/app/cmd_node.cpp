@@ -4,11 +4,11 @@
 // DDS (docs/formats.md, "Camera nodes"). Structure: load the configuration (ConfigRole::kNode: no
 // tracker) -> open and configure the cameras (replay with `camera: NAME`, v4l2, libcamera;
 // `trigger: central` follows the central tracker) -> NodeSender (DDS threads)
-// + NodeRunner (a real-time thread per camera) -> run until --duration, SIGINT/SIGTERM or
-// the end of every replay -> flush (the end-of-stream messages reach the central) ->
-// one report line per camera on stdout. --check-config stops after the checks (plan_node:
-// the configuration, the backend, the replay recording and its cameras) and prints a
-// summary, as `mocap run --check-config` does; it needs neither cameras nor DDS.
+// + NodeRunner (real-time detection workers, node.detect_threads) -> run until --duration,
+// SIGINT/SIGTERM or the end of every replay -> flush (the end-of-stream messages reach the central)
+// -> one report line per camera on stdout. --check-config stops after the checks (plan_node: the
+// configuration, the backend, the replay recording and its cameras) and prints a summary, as `mocap
+// run --check-config` does; it needs neither cameras nor DDS.
 #include <unistd.h>
 
 #include <atomic>
@@ -183,6 +183,7 @@ int run_node(const NodeArgs& a) {
   opt.node_name = name;
   opt.trigger_rate_hz = cfg->pipeline.trigger_rate_hz;
   opt.realtime = cfg->pipeline.realtime;
+  opt.detect_threads = cfg->node.detect_threads;
   auto runner = node::NodeRunner::create(specs, cfg->tracker.detect, opt, **sender);
   if (!runner) return fail(runner.error().message);
 
@@ -197,8 +198,9 @@ int run_node(const NodeArgs& a) {
     std::fprintf(stderr, "mocap node: note: %s\n", n.c_str());
   for (const std::string& n : (*sender)->notes())
     std::fprintf(stderr, "mocap node: note: %s\n", n.c_str());
-  std::fprintf(stderr, "mocap node: %s publishing %zu cameras on DDS domain %u\n", name.c_str(),
-               specs.size(), cfg->node.domain_id);
+  std::fprintf(stderr,
+               "mocap node: %s publishing %zu cameras on DDS domain %u (%d detection workers)\n",
+               name.c_str(), specs.size(), cfg->node.domain_id, (*runner)->workers());
   const auto t0 = std::chrono::steady_clock::now();
   bool ended = false;
   while (!g_node_stop.load(std::memory_order_relaxed)) {

@@ -74,7 +74,9 @@ namespace mocap::config_detail {
 // software | central), replay `camera: NAME`; the `node:` section; pipeline.pair_by and
 // pair_tolerance_us.
 void read_node_camera_keys(const Section& s, config::CameraSettings& cam);
-void read_node_section(const YAML::Node& node, config::NodeSettings& n);
+// `cameras`: the configuration's (read before), for node.detect_threads' check.
+void read_node_section(const YAML::Node& node, const std::vector<config::CameraSettings>& cameras,
+                       config::NodeSettings& n);
 void read_pair_keys(const Section& s, config::PipelineSettings& p);
 
 // The `outputs:` map (run_config_outputs.cpp); `file` prefixes the registry outputs' errors.

@@ -285,7 +285,7 @@ Expected<RunConfig> parse(const std::string& path, const YAML::Node& root, Confi
        "stereo", "identification", "velocity", "sim", "service", "fault_injection", "node"});
   (void)top.integer("version", 1, 1);  // the only version so far; checked for the future
   if (top.has("cameras")) read_cameras(top.node("cameras"), base, cfg, role);
-  config_detail::read_node_section(top.node("node"), cfg.node);
+  config_detail::read_node_section(top.node("node"), cfg.cameras, cfg.node);
   if (const auto v = top.text("rig")) cfg.rig_path = resolve(base, *v);
   if (const auto v = top.text("targets")) cfg.targets_path = resolve(base, *v);
   if (const auto v = top.text("model")) cfg.model_path = resolve(base, *v);

@@ -141,6 +141,9 @@ struct NodeSettings {
   std::uint32_t domain_id = 0;
   int timeout_ms = 100;  // central: a frame not arrived this long after its trigger is missing
   double wait_s = 10.0;  // central: how long start waits for every node to be discovered
+  // node: the detection workers of its `trigger: central` cameras (1..their count); 0: the
+  // default, min(those cameras, online CPUs)
+  int detect_threads = 0;
 };
 
 // Which command reads the configuration: `mocap node` takes 1..8 cameras of its own PC

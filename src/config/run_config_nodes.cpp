@@ -4,13 +4,15 @@
 //                       or software-triggered camera follows the central triggers)
 //   cameras[i].camera   replay: the recording's camera NAME this camera plays
 //   cameras[i].device   node backend: NODE/CAMERA
-//   node:               {name, domain_id, timeout_ms, wait_s}
+//   node:               {name, domain_id, timeout_ms, wait_s, detect_threads}
 //   pipeline.pair_by    sequence | timestamp, pipeline.pair_tolerance_us
 // Each is checked here with the one-line "FILE: key: problem" error of the reader.
 #include <string>
+#include <vector>
 
 #include "config/config_reader.h"
 #include "config/run_config.h"
+#include "core/camera_set.h"
 #include "formats/yaml_read.h"
 
 namespace mocap::config_detail {
@@ -47,8 +49,9 @@ void read_node_camera_keys(const Section& s, config::CameraSettings& cam) {
   }
 }
 
-void read_node_section(const YAML::Node& node, config::NodeSettings& n) {
-  const Section s(node, "node", {"name", "domain_id", "timeout_ms", "wait_s"});
+void read_node_section(const YAML::Node& node, const std::vector<config::CameraSettings>& cameras,
+                       config::NodeSettings& n) {
+  const Section s(node, "node", {"name", "domain_id", "timeout_ms", "wait_s", "detect_threads"});
   if (const auto v = s.text("name")) {
     for (char ch : *v) {
       if (ch <= ' ' || ch > '~' || ch == '/')
@@ -60,6 +63,16 @@ void read_node_section(const YAML::Node& node, config::NodeSettings& n) {
   if (const auto v = s.integer("domain_id", 0, 232)) n.domain_id = static_cast<std::uint32_t>(*v);
   if (const auto v = s.integer("timeout_ms", 1, 10'000)) n.timeout_ms = static_cast<int>(*v);
   if (const auto v = s.number("wait_s", 0.0, 3600.0)) n.wait_s = *v;
+  if (const auto v = s.integer("detect_threads", 1, kMaxNodeCameras)) {
+    std::int64_t central = 0;
+    for (const config::CameraSettings& c : cameras) central += c.central_trigger ? 1 : 0;
+    if (central == 0)
+      s.bad("detect_threads", "no camera has trigger: central (the workers serve those cameras)");
+    if (*v > central)
+      s.bad("detect_threads", std::to_string(*v) + " workers for " + std::to_string(central) +
+                                  " cameras with trigger: central (at most one per camera)");
+    n.detect_threads = static_cast<int>(*v);
+  }
 }
 
 void read_pair_keys(const Section& s, config::PipelineSettings& p) {

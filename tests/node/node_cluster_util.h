@@ -105,6 +105,8 @@ struct Cluster {
   std::string central_trigger;                    // the central cameras' (empty: none given)
   // How long the central waits for a node's frame before it is missing.
   int timeout_ms = 5000;
+  // Node n's further `node:` keys (e.g. ", detect_threads: 1"); none past the list's end.
+  std::vector<std::string> node_keys;
 
   static constexpr int kNodes = 2;
 
@@ -115,8 +117,10 @@ struct Cluster {
   // central_keys).
   void write_configs(const std::string& central_keys) const {
     for (int n = 0; n < kNodes; ++n) {
+      const auto un = static_cast<std::size_t>(n);
       std::string y = "node: {name: " + node_name + std::to_string(n) +
-                      ", domain_id: " + std::to_string(domain_id) + "}\npipeline: {" +
+                      ", domain_id: " + std::to_string(domain_id) +
+                      (un < node_keys.size() ? node_keys[un] : "") + "}\npipeline: {" +
                       node_pipeline + "}\ncameras:\n";
       for (int c = cameras_per_node * n; c < cameras_per_node * (n + 1); ++c)
         y += "  - {backend: replay, device: " + recording + ", camera: cam" + std::to_string(c) +

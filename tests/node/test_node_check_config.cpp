@@ -3,7 +3,8 @@
 // /dev/video0 is never opened, and replay cameras of the node_recording fixture); exit 1
 // and exactly one line naming the file and the key for each kind of bad input (an unknown
 // key, a backend a node cannot run, a recording camera that does not exist, two cameras
-// publishing the same name, 9 cameras: a node publishes at most 8). No DDS and no camera is
+// publishing the same name, 9 cameras: a node publishes at most 8; more detection workers
+// than central-triggered cameras, or none to serve). No DDS and no camera is
 // touched.
 #include <gtest/gtest.h>
 
@@ -39,8 +40,9 @@ TEST(NodeCheckConfig, AcceptsReplayCamerasAndNamesThem) {
   TempDir dir("node_check_ok");
   const std::string rec = MOCAP_TEST_NODE_RECORDING;
   write_file(dir.file("node.yaml"),
-             "node: {name: n1, domain_id: 7}\ncameras:\n  - {backend: replay, device: " + rec +
-                 ", camera: cam5, trigger: central}\n  - {backend: replay, device: " + rec +
+             "node: {name: n1, domain_id: 7, detect_threads: 2}\ncameras:\n  - {backend: replay, "
+             "device: " +
+                 rec + ", camera: cam5, trigger: central}\n  - {backend: replay, device: " + rec +
                  ", camera: cam6, trigger: central}\n");
   int rc = -1;
   const std::string out = check(dir.file("node.yaml"), rc);
@@ -82,6 +84,20 @@ TEST(NodeCheckConfig, RejectsBadInputWithOneLineNamingFileAndKey) {
              return list;
            }(),
        "cameras: 9 cameras, at most 8 (line 2)"},
+      {"workers.yaml",
+       "node: {detect_threads: 2}\ncameras:\n  - {backend: replay, device: " + rec +
+           ", camera: cam1, trigger: central}\n  - {backend: replay, device: " + rec +
+           ", camera: cam2}\n",
+       "node.detect_threads: 2 workers for 1 cameras with trigger: central (at most one per "
+       "camera)"},
+      {"workers_none.yaml",
+       "node: {detect_threads: 1}\ncameras:\n  - {backend: v4l2, device: /dev/video0, width: "
+       "640, height: 480}\n",
+       "node.detect_threads: no camera has trigger: central (the workers serve those cameras)"},
+      {"workers_zero.yaml",
+       "node: {detect_threads: 0}\ncameras:\n  - {backend: replay, device: " + rec +
+           ", camera: cam1, trigger: central}\n",
+       "node.detect_threads: must be in [1, 8], got 0"},
       {"no_recording.yaml",
        "cameras:\n  - {backend: replay, device: " + dir.file("nothing") + "}\n",
        "cameras[0].device: "},

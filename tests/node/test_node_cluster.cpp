@@ -1,7 +1,8 @@
 // End-to-end test of the camera nodes (issue 29) on loopback: two `mocap node` processes
 // replay 4 cameras each of an 8-camera recording (fixture node_recording) with `trigger:
 // central`, and one central `mocap run` (pacing lockstep, cameras `backend: node`) tracks
-// them. Checked against the same recording replayed in one process: every frame is
+// them (node n0 on one detection worker, n1 on the default count, min(4 cameras, CPUs)).
+// Checked against the same recording replayed in one process: every frame is
 // published and the joint angles (UDP datagrams) are equal within 1e-5 rad; with one node
 // killed mid-run the central goes on publishing from the other node's cameras and ends
 // normally when the replay ends; the node restarted is used again, in step (its replay
@@ -55,8 +56,10 @@ class NodeCluster : public ::testing::Test {
   // The nodes follow the central's triggers (lockstep at rate_hz). timeout_ms: how long
   // the central waits for a node's frame before it is missing (the sanitizer builds' nodes
   // take ~0.1-0.3 s per frame).
+  // Node n0 detects on one worker (node.detect_threads), n1 on the default count.
   void write_cluster(int port, double rate_hz, int timeout_ms) {
     cluster_.timeout_ms = timeout_ms;
+    cluster_.node_keys = {", detect_threads: 1", ""};
     cluster_.write_configs(tracker_keys(port, rate_hz));
   }
   // The reference: the recording replayed by one process (8 local replay cameras).
