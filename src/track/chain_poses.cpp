@@ -20,12 +20,12 @@
 // wrong, and an angle from it would be too. So is a refit whose rotation sd exceeds
 // max_sd_deg. Standard deviations: the refit's rotation covariance plus the parent's, in
 // the parent's frame.
+#include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <cmath>
 #include <numbers>
 
 #include "core/rotation.h"
-#include "core/small_cholesky.h"
 #include "identify/consistency.h"
 #include "track/chain_solver.h"
 
@@ -147,13 +147,13 @@ bool ChainSolver::refit_child(int j, const JointEvidence& ev, const MeasuredPoin
     Vec6 g;
     int m = 0;
     double chi2 = 0.0;
-    SmallCholesky<6> chol;
-    bool at_pose = false;  // H, g, chi2 and chol belong to (R, t)
+    Eigen::LLT<Mat6> llt;
+    bool at_pose = false;  // H, g, chi2 and llt belong to (R, t)
     for (int iter = 0; iter < 6; ++iter) {
       chi2 = normal(R, t, H, g, m);
       if (m < 2) return false;
-      if (!chol.compute(H)) return false;
-      const Vec6 step = chol.solve(-g);
+      if (llt.compute(H).info() != Eigen::Success) return false;
+      const Vec6 step = llt.solve(-g);
       if (!step.allFinite()) return false;
       if (step.cwiseAbs().maxCoeff() < 1e-10) {
         at_pose = true;
@@ -167,9 +167,9 @@ bool ChainSolver::refit_child(int j, const JointEvidence& ev, const MeasuredPoin
     }
     if (!at_pose) {
       chi2 = normal(R, t, H, g, m);
-      if (!chol.compute(H)) return false;
+      if (llt.compute(H).info() != Eigen::Success) return false;
     }
-    const Mat6 C = chol.inverse();
+    const Mat6 C = llt.solve(Mat6::Identity());
     // Each term tested alone: the drop of the sum of squares when it leaves the fit,
     // r^T (Sigma - J C J^T)^-1 r (a biased marker is diluted in the global sum, and the
     // fit absorbs most of it along the directions its spread leaves loose). As a share of
