@@ -132,6 +132,19 @@ class Camera {
   virtual void stop() noexcept = 0;
 
   virtual CameraStatus trigger() noexcept = 0;
+  // A camera whose software trigger travels before it fires (a camera node's, over the
+  // network) is triggered ahead: the capture stage calls trigger_at(at_ns) up to
+  // trigger_lead_ns() before the trigger instant at_ns (CLOCK_MONOTONIC), and the camera
+  // fires at at_ns (at once when the trigger arrives later). 0: no lead, trigger() at
+  // the instant. A frame's latency starts at at_ns either way.
+  virtual std::int64_t trigger_lead_ns() const noexcept { return 0; }
+  virtual CameraStatus trigger_at(std::int64_t at_ns) noexcept {
+    (void)at_ns;
+    return trigger();
+  }
+  // The camera's frames carry blobs detected elsewhere (Frame::blobs: a camera node's)
+  // and no image: the pipeline hands them on without a detection thread.
+  virtual bool delivers_blobs() const noexcept { return false; }
   virtual CameraStatus dequeue(Frame& out, int timeout_ms) noexcept = 0;
   virtual CameraStatus release(const Frame& frame) noexcept = 0;
 

@@ -86,6 +86,9 @@ class FaultCamera final : public Camera {
   Expected<void> start() override;
   void stop() noexcept override;
   CameraStatus trigger() noexcept override { return inner_.trigger(); }
+  std::int64_t trigger_lead_ns() const noexcept override { return inner_.trigger_lead_ns(); }
+  CameraStatus trigger_at(std::int64_t at_ns) noexcept override { return inner_.trigger_at(at_ns); }
+  bool delivers_blobs() const noexcept override { return inner_.delivers_blobs(); }
   CameraStatus dequeue(Frame& out, int timeout_ms) noexcept override;
   CameraStatus release(const Frame& frame) noexcept override { return inner_.release(frame); }
   const CameraConfig& config() const noexcept override { return inner_.config(); }

@@ -97,15 +97,24 @@ void CaptureStage::run() noexcept {
   const PipelineOptions& o = context_.options();
   Counters& k = counters_;
   std::array<bool, kMaxCameras> software{};
-  bool triggered_mode = false;
+  std::array<bool, kMaxCameras> ahead{};  // triggered ahead of the instant (trigger_at)
+  bool triggered_mode = false, at_instant = false;
+  const auto period_ns = static_cast<std::int64_t>(1e9 / o.trigger_rate_hz);
+  std::int64_t lead_ns = 0;
   for (int c = 0; c < camera_count_; ++c) {
     const auto ci = static_cast<std::size_t>(c);
     software[ci] = cameras_[ci]->config().trigger == hal::TriggerMode::kSoftware;
     triggered_mode = triggered_mode || software[ci];
+    const std::int64_t lead = software[ci] ? cameras_[ci]->trigger_lead_ns() : 0;
+    ahead[ci] = lead > 0;
+    at_instant = at_instant || (software[ci] && !ahead[ci]);
+    lead_ns = std::max(lead_ns, lead);
   }
-  const auto period_ns = static_cast<std::int64_t>(1e9 / o.trigger_rate_hz);
+  // At most half a period ahead: the previous trigger's frames come first (the
+  // configuration refuses more; this bounds what a camera asks).
+  lead_ns = std::min(lead_ns, period_ns / 2);
   setup_clock_checks(triggered_mode, period_ns);
-  std::int64_t next_trigger_ns = monotonic_ns();
+  std::int64_t next_trigger_ns = monotonic_ns() + lead_ns;  // the first one ahead too
   std::int64_t last_trigger_ns = 0;  // host time of the last software trigger
   bool end_of_stream = false;        // a camera has no more frames (replay)
   while (!context_.stopping()) {
@@ -118,23 +127,33 @@ void CaptureStage::run() noexcept {
         continue;
       }
       // Both pacings: at most trigger_rate_hz (lockstep may trigger later, never earlier).
-      hal::sleep_until_ns(next_trigger_ns);
+      // The cameras with a lead are triggered that long before the instant.
+      hal::sleep_until_ns(next_trigger_ns - lead_ns);
       const std::int64_t now = monotonic_ns();
-      // How late this trigger fires (the capture thread was not scheduled in time, or a
-      // camera call overran): invisible in the latencies, which start at the trigger.
+      // How late this trigger is posted (the capture thread was not scheduled in time, or
+      // a camera call overran): invisible in the latencies, which start at the trigger.
       raise_to(k.trigger_late_max_us,
-               static_cast<std::uint64_t>(std::max<std::int64_t>(now - next_trigger_ns, 0) / 1000));
+               static_cast<std::uint64_t>(
+                   std::max<std::int64_t>(now - (next_trigger_ns - lead_ns), 0) / 1000));
+      const std::int64_t instant = std::max(next_trigger_ns, now);
       next_trigger_ns += period_ns;
-      if (next_trigger_ns < now) {  // overran a whole period: re-phase, triggers skipped
-        k.trigger_overruns.add(static_cast<std::uint64_t>((now - next_trigger_ns) / period_ns) + 1);
-        next_trigger_ns = now + period_ns;
+      if (next_trigger_ns < instant) {  // overran a whole period: re-phase, triggers skipped
+        k.trigger_overruns.add(static_cast<std::uint64_t>((instant - next_trigger_ns) / period_ns) +
+                               1);
+        next_trigger_ns = instant + period_ns;
       }
       for (int c = 0; c < camera_count_; ++c) {
         const auto ci = static_cast<std::size_t>(c);
-        if (software[ci] && cameras_[ci]->trigger() != hal::CameraStatus::kOk)
+        if (ahead[ci] && cameras_[ci]->trigger_at(instant) != hal::CameraStatus::kOk)
           k.trigger_errors.add();
       }
-      last_trigger_ns = now;
+      if (at_instant && lead_ns > 0) hal::sleep_until_ns(instant);
+      for (int c = 0; c < camera_count_; ++c) {
+        const auto ci = static_cast<std::size_t>(c);
+        if (software[ci] && !ahead[ci] && cameras_[ci]->trigger() != hal::CameraStatus::kOk)
+          k.trigger_errors.add();
+      }
+      last_trigger_ns = instant;
       k.triggered.add();
     }
     // Wait for each camera's frame at most dequeue_timeout_ms and never past the next
@@ -145,7 +164,7 @@ void CaptureStage::run() noexcept {
     for (int c = 0; c < camera_count_; ++c) {
       int timeout_ms = 5;  // free-run: the cameras are polled in turn
       if (triggered_mode) {
-        const std::int64_t left_ns = next_trigger_ns - monotonic_ns();
+        const std::int64_t left_ns = next_trigger_ns - lead_ns - monotonic_ns();
         const std::int64_t left_ms = (left_ns + 999'999) / 1'000'000;  // round up
         timeout_ms = static_cast<int>(std::clamp<std::int64_t>(left_ms, 0, o.dequeue_timeout_ms));
       }
@@ -197,7 +216,11 @@ bool CaptureStage::poll_camera(int c, int timeout_ms, bool triggered_mode,
     if (o.tap != nullptr) o.tap->on_frame(c, f);
     if (!triggered_mode && c == 0) k.triggered.add();
     last_sequence = f.sequence;
-    if (detect_[ci]->input().try_push(f)) {
+    if (detect_[ci]->passes_through()) {  // blobs detected elsewhere: handed on here
+      detect_[ci]->pass(f);
+      pushed = true;
+      if (cam.release(f) != hal::CameraStatus::kOk) k.release_errors.add();
+    } else if (detect_[ci]->input().try_push(f)) {
       pushed = true;
       context_.bell(StageId::detect(c)).ring();
     } else {  // the detector holds every slot (stalled): drop this frame

@@ -1,10 +1,12 @@
 // Design: the capture stage (one thread, the highest priority of the stage table). It
 // drives the rig's cameras: fires the software triggers on their grid (absolute
-// deadlines; lockstep pacing waits for the previous frame to be retired), dequeues every
+// deadlines; lockstep pacing waits for the previous frame to be retired; a camera with a
+// trigger lead, a camera node's, gets trigger_at(instant) that long ahead), dequeues every
 // camera without ever waiting on a stalled one past the next trigger, counts each
 // camera's clock steps (timestamp_check.h; the frame goes on unchanged), offers each
 // frame to the FrameTap (`mocap record`), hands it to its camera's detect stage (dropped
-// when the detector holds every slot: capture_dropped_cam#) and releases the buffers the
+// when the detector holds every slot: capture_dropped_cam#; a camera that delivers blobs,
+// a camera node's, is handed on here through DetectStage::pass) and releases the buffers the
 // detect stages give back. It alone calls the cameras' release(), so every camera buffer
 // has one owner thread. A camera's end of stream (a replayed recording's last frame was
 // delivered) ends the triggering, as max_frames does. It owns no ring: each detect stage owns its

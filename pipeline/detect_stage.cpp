@@ -24,13 +24,14 @@ Expected<std::unique_ptr<DetectStage>> DetectStage::create(int camera, const hal
   const auto back = static_cast<std::uint32_t>(
       rt::next_power_of_two_at_least(static_cast<std::size_t>(camera_buffers)));
   return std::unique_ptr<DetectStage>(
-      new DetectStage(camera, input, back, context, processor, out));
+      new DetectStage(camera, input, back, context, processor, out, cam.delivers_blobs()));
 }
 
 DetectStage::DetectStage(int camera, std::uint32_t input_capacity, std::uint32_t return_capacity,
                          StageContext& context, FrameProcessor& processor,
-                         rt::SlotPool<BlobSlot>& out)
+                         rt::SlotPool<BlobSlot>& out, bool passes_through)
     : camera_(camera),
+      passes_through_(passes_through),
       context_(context),
       processor_(processor),
       out_(out),
@@ -42,9 +43,7 @@ void DetectStage::run() noexcept {
   const StageId id = StageId::detect(camera_);
   context_.loop_start(id);
   Doorbell& bell = context_.bell(id);
-  Doorbell& next = context_.bell(StageId::kIdentify);
   const PipelineOptions& options = context_.options();
-  BlobTap* const tap = context_.options().blob_tap;
   while (!context_.stopping()) {
     const std::uint32_t seen = bell.snapshot();
     hal::Frame f;
@@ -60,38 +59,45 @@ void DetectStage::run() noexcept {
       counters_.skipped.add();
       f = newer;
     }
-    rt::SlotHandle h;
-    if (!out_.acquire(h)) {  // identify holds every slot (stalled): drop
-      counters_.no_slot.add();
-      returned_.try_push(f);
-      continue;
-    }
-    const std::int64_t t0 = monotonic_ns();
-    BlobSlot& slot = out_[h];
-    slot.blobs.clear();
-    slot.present = !f.missing && (!f.image.empty() || f.blobs != nullptr);
-    if (slot.present && f.blobs != nullptr) {  // a camera node detected them: pass through
-      for (const detect::Blob& b : *f.blobs) slot.blobs.push_back(b);  // capacity: counted
-      slot.blobs.set_levels(f.blobs->levels());
-      library_.blobs.add(slot.blobs.size());
-    } else if (slot.present) {
-      processor_.detect_camera(camera_, f.image, slot.blobs);
-      library_.blobs.add(slot.blobs.size());
-      library_.detector.publish(kDetectorFields, processor_.detector_counters(camera_));
-    }
-    if (tap != nullptr) tap->on_blobs(camera_, f, slot.present, slot.blobs);
-    slot.sequence = f.sequence;
-    slot.capture_ns = f.timestamp_ns;
-    const std::int64_t origin_ns = hal::latency_origin_ns(f);
-    slot.origin_ns = origin_ns;  // (a local copy: the slot is identify's once published)
-    returned_.try_push(f);       // the image is no longer needed
-    out_.publish(h);
-    next.ring();
-    const std::int64_t t1 = monotonic_ns();
-    work_.record(t1 - t0);
-    latency_.record(t1 - origin_ns);
+    (void)fill_slot(f);
+    returned_.try_push(f);  // the image is no longer needed
   }
   context_.loop_end(id);
+}
+
+void DetectStage::pass(const hal::Frame& f) noexcept { (void)fill_slot(f); }
+
+bool DetectStage::fill_slot(const hal::Frame& f) noexcept {
+  rt::SlotHandle h;
+  if (!out_.acquire(h)) {  // identify holds every slot (stalled): drop
+    counters_.no_slot.add();
+    return false;
+  }
+  const std::int64_t t0 = monotonic_ns();
+  BlobSlot& slot = out_[h];
+  slot.blobs.clear();
+  slot.present = !f.missing && (!f.image.empty() || f.blobs != nullptr);
+  if (slot.present && f.blobs != nullptr) {  // a camera node detected them: pass through
+    for (const detect::Blob& b : *f.blobs) slot.blobs.push_back(b);  // capacity: counted
+    slot.blobs.set_levels(f.blobs->levels());
+    library_.blobs.add(slot.blobs.size());
+  } else if (slot.present) {
+    processor_.detect_camera(camera_, f.image, slot.blobs);
+    library_.blobs.add(slot.blobs.size());
+    library_.detector.publish(kDetectorFields, processor_.detector_counters(camera_));
+  }
+  if (BlobTap* const tap = context_.options().blob_tap; tap != nullptr)
+    tap->on_blobs(camera_, f, slot.present, slot.blobs);
+  slot.sequence = f.sequence;
+  slot.capture_ns = f.timestamp_ns;
+  const std::int64_t origin_ns = hal::latency_origin_ns(f);
+  slot.origin_ns = origin_ns;  // (a local copy: the slot is identify's once published)
+  out_.publish(h);
+  context_.bell(StageId::kIdentify).ring();
+  const std::int64_t t1 = monotonic_ns();
+  work_.record(t1 - t0);
+  latency_.record(t1 - origin_ns);
+  return true;
 }
 
 void DetectStage::report(rt::CounterReport& out) const {

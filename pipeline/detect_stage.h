@@ -6,7 +6,10 @@
 //   input ring --newest frame--> FrameProcessor::detect_camera --> blob slot (identify)
 //        ^-- older frames (skipped) and the detected frame go back on the return ring
 // A camera node's frame (hal::Frame::blobs, pipeline/node/node_camera.h) carries the blobs
-// its node detected and no image: they are copied into the blob slot, not detected.
+// its node detected and no image: they are copied into the blob slot, not detected. Such a
+// camera's stage (hal::Camera::delivers_blobs) has no thread: the capture thread hands each
+// frame through pass() (the one producer of its blob slots, the only writer of its
+// counters), which saves a thread's wake-up between the blobs' arrival and identify.
 // Drop policy: it works on the NEWEST frame and returns the older ones (detect#_skipped);
 // when identify holds every blob slot the frame is dropped (detect#_no_slot). With
 // options.every_frame (`mocap record --blobs`, `pipeline.every_frame`) it detects every frame in
@@ -42,6 +45,10 @@ class DetectStage {
                                                        rt::SlotPool<BlobSlot>& out);
 
   void run() noexcept;  // the thread's body, until the context stops
+  // The camera delivers blobs (no detection): no thread; the capture thread calls pass()
+  // for each frame and releases the frame itself afterwards.
+  bool passes_through() const noexcept { return passes_through_; }
+  void pass(const hal::Frame& f) noexcept;
 
   // The capture thread's ends: push frames in, take frames back.
   rt::SpscRing<hal::Frame>& input() noexcept { return input_; }
@@ -58,9 +65,14 @@ class DetectStage {
 
  private:
   DetectStage(int camera, std::uint32_t input_capacity, std::uint32_t return_capacity,
-              StageContext& context, FrameProcessor& processor, rt::SlotPool<BlobSlot>& out);
+              StageContext& context, FrameProcessor& processor, rt::SlotPool<BlobSlot>& out,
+              bool passes_through);
+  // The frame's blobs (detected, or passed on) into a blob slot for identify; false when
+  // identify holds every slot (counted: dropped).
+  bool fill_slot(const hal::Frame& f) noexcept;
 
   const int camera_;
+  const bool passes_through_;
   StageContext& context_;
   FrameProcessor& processor_;
   rt::SlotPool<BlobSlot>& out_;

@@ -139,7 +139,10 @@ Expected<void> Pipeline::start_threads() {
   threads_.clear();
   // Consumers first, so that no producer ever runs ahead of a missing consumer.
   std::vector<StageId> order = {StageId::kPublish, StageId::kIdentify};
-  for (int c = 0; c < camera_count(); ++c) order.push_back(StageId::detect(c));
+  for (int c = 0; c < camera_count(); ++c) {  // a stage that passes blobs on has no thread
+    if (!detect_[static_cast<std::size_t>(c)]->passes_through())
+      order.push_back(StageId::detect(c));
+  }
   order.push_back(StageId::kCapture);
   for (StageId id : order) {
     const ResolvedStage& s = stage(id);

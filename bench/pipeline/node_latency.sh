@@ -7,20 +7,25 @@
 # both `pipeline: {pacing: lockstep}` at 100 Hz, so every frame of the recording is
 # published, and both print `publish (end to end)` (p50, p99, p99.9, max in us), camera 0's
 # frame's software trigger -> the frame's publication, in both on the tracker's
-# CLOCK_MONOTONIC at the same instant (the capture thread's trigger() call of camera 0):
-# in (a) the replay stamps its frame with its trigger (hal/replay_camera.h), in (b) the
-# node camera with the central trigger, so (b) adds exactly the trigger's way to the node,
-# the node's replay and detection, the blob message's way back and the central's hand-over
-# of the blobs instead of the detection. The central's report also splits (b) into its
+# CLOCK_MONOTONIC from the trigger's instant: in (a) the replay stamps its frame with its
+# trigger() call (hal/replay_camera.h); in (b) the node camera with the trigger's instant,
+# at which the nodes fire (node.trigger_lead_us ahead of it the central sent the trigger;
+# with LEAD 0 the central's trigger() call, and the trigger's way to the node counts), so
+# (b) adds the node's replay and detection (and the wait of a trigger that came after its
+# instant), the blob message's way back and the central's hand-over of the blobs instead
+# of the detection. The central's report also splits (b) into its
 # legs (`node_trigger_leg`, `node_work`, `node_transit`).
-# Usage: bash bench/pipeline/node_latency.sh [MOCAP] REC [OUT] [RUNS] [REALTIME] [DETECT]
+# Usage: bash bench/pipeline/node_latency.sh [MOCAP] REC [OUT] [RUNS] [REALTIME] [DETECT] [LEAD]
 #   REC: an 8-camera recording with targets.yaml and gt/model_true.yaml, e.g.
 #        `mocap simulate --scene humanoid --cameras 8 --frames 200 --out REC`;
 #   DETECT: each node's node.detect_threads, or `default` (min(4, CPUs)); 1 by default:
 #        two nodes sharing this PC's cores split them as a lab splits a shared PC
 #        (docs/operations.md), and (b) detects as (a) does: 4 cameras after one another on
 #        each of the 2 cores;
-#   defaults: build/mocap, -, /tmp/node_latency, 3 runs, realtime false, 1.
+#   LEAD: the central's node.trigger_lead_us (the nodes fire at the trigger's instant, the
+#        trigger sent that long ahead; 0: they fire when it arrives, and its way counts),
+#        or `default` (the configuration's default, 1000);
+#   defaults: build/mocap, -, /tmp/node_latency, 3 runs, realtime false, 1, default.
 # docs/performance.md records the figures with the machine.
 set -euo pipefail
 mocap=$(realpath "${1:-build/mocap}")
@@ -30,6 +35,8 @@ runs=${4:-3}
 realtime=${5:-false}
 detect=${6:-1}
 workers=$([ "$detect" = default ] || echo ", detect_threads: $detect")
+lead=${7:-default}
+lead_key=$([ "$lead" = default ] || echo ", trigger_lead_us: $lead")
 domain=$((100 + $$ % 100))
 mkdir -p "$out"
 rm -f "$out/added.txt"
@@ -55,7 +62,8 @@ for n in 0 1; do
   } >"$out/node$n.yaml"
 done
 {
-  printf 'node: {domain_id: %s, wait_s: 20, timeout_ms: 2000}\nrig: %s/rig.yaml\ncameras:\n' "$domain" "$rec"
+  printf 'node: {domain_id: %s, wait_s: 20, timeout_ms: 2000%s}\nrig: %s/rig.yaml\ncameras:\n' "$domain" \
+    "$lead_key" "$rec"
   for c in 0 1 2 3 4 5 6 7; do echo "  - {backend: node, device: n$((c / 4))/cam$c}"; done
   tracker_keys
 } >"$out/central.yaml"

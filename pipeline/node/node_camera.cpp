@@ -72,11 +72,19 @@ void NodeCamera::stop() noexcept {
   state_ = hal::CameraState::kConfigured;
 }
 
-hal::CameraStatus NodeCamera::trigger() noexcept {
+hal::CameraStatus NodeCamera::trigger() noexcept { return post(monotonic_ns(), 0); }
+
+std::int64_t NodeCamera::trigger_lead_ns() const noexcept {
+  return central_ ? link_->trigger_lead_ns() : 0;
+}
+
+hal::CameraStatus NodeCamera::trigger_at(std::int64_t at_ns) noexcept { return post(at_ns, at_ns); }
+
+hal::CameraStatus NodeCamera::post(std::int64_t instant_ns, std::int64_t fire_ns) noexcept {
   if (state_ != hal::CameraState::kStreaming) return hal::CameraStatus::kNotStreaming;
   if (!central_) return hal::CameraStatus::kUnsupported;
-  trigger_ns_[triggered_ % kWindow] = monotonic_ns();
-  link_->trigger(triggered_);
+  trigger_ns_[triggered_ % kWindow] = instant_ns;
+  link_->trigger(triggered_, fire_ns);
   ++triggered_;
   return hal::CameraStatus::kOk;
 }

@@ -6,7 +6,9 @@
 // Trigger modes:
 //   kSoftware (default): the central tracker triggers; trigger() posts central trigger k
 //     (the camera's k-th trigger, the same k for every node camera) to the nodes, whose
-//     `trigger: central` cameras answer with frame number k. dequeue() delivers frame k in
+//     `trigger: central` cameras answer with frame number k; trigger_at(t) posts it
+//     node.trigger_lead_us ahead of its instant t, at which the nodes fire (the frame's
+//     latency starts at t, or at trigger()'s call). dequeue() delivers frame k in
 //     order, and survives the node: a frame not arrived `timeout_ms` after its trigger is
 //     delivered as MISSING (the set goes on with the other cameras); after 3 missing in a
 //     row the camera is down and its frames are missing at once, until a message of it
@@ -49,6 +51,10 @@ class NodeCamera final : public hal::CameraBase {
   Expected<void> start() override;
   void stop() noexcept override;
   hal::CameraStatus trigger() noexcept override;
+  // node.trigger_lead_us (kSoftware): the nodes fire at the instant trigger_at() names.
+  std::int64_t trigger_lead_ns() const noexcept override;
+  hal::CameraStatus trigger_at(std::int64_t at_ns) noexcept override;
+  bool delivers_blobs() const noexcept override { return true; }
   hal::CameraStatus dequeue(hal::Frame& out, int timeout_ms) noexcept override;
   hal::CameraStatus release(const hal::Frame& frame) noexcept override;
 
@@ -62,6 +68,9 @@ class NodeCamera final : public hal::CameraBase {
   NodeCamera(std::shared_ptr<NodeLink> link, int index, std::string device, int timeout_ms);
   static constexpr std::uint32_t kNoSlot = 0xffffffffu;
   static constexpr std::size_t kWindow = 256;  // trigger times / delivered marks kept
+  // Posts the next central trigger: its latencies start at instant_ns, the nodes fire at
+  // fire_ns (0: on arrival).
+  hal::CameraStatus post(std::int64_t instant_ns, std::int64_t fire_ns) noexcept;
   // Takes the next message of the inbox into held_ (true) or nothing is there.
   bool take() noexcept;
   void deliver_held(hal::Frame& out) noexcept;

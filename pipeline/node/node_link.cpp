@@ -1,6 +1,7 @@
 // Design: see node_link.h.
 #include "pipeline/node/node_link.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <thread>
@@ -10,7 +11,8 @@
 namespace mocap::node {
 
 Expected<std::shared_ptr<NodeLink>> NodeLink::create(std::uint32_t domain_id, double wait_s,
-                                                     bool realtime) {
+                                                     bool realtime, std::int64_t trigger_lead_ns) {
+  if (trigger_lead_ns < 0) return make_error("mocap run", "node.trigger_lead_us", "must be >= 0");
   std::shared_ptr<NodeLink> l(new NodeLink());
   auto d = NodeDomain::open(domain_id, "mocap run: nodes", realtime);
   if (!d) return d.error();
@@ -21,9 +23,10 @@ Expected<std::shared_ptr<NodeLink>> NodeLink::create(std::uint32_t domain_id, do
   auto w = l->domain_.writer(l->domain_.trigger_topic(), "mocap run: mocap/trigger");
   if (!w) return w.error();
   l->writer_ = *w;
-  auto ring = rt::SpscRing<std::uint64_t>::create(1024);
+  auto ring = rt::SpscRing<Posted>::create(1024);
   if (!ring) return ring.error();
-  l->triggers_ = std::make_unique<rt::SpscRing<std::uint64_t>>(std::move(ring).value());
+  l->triggers_ = std::make_unique<rt::SpscRing<Posted>>(std::move(ring).value());
+  l->trigger_lead_ns_ = trigger_lead_ns;
   l->wait_s_ = wait_s;
   l->realtime_ = realtime;
   return l;
@@ -119,22 +122,26 @@ void NodeLink::stop() noexcept {
   if (trigger_thread_.joinable()) trigger_thread_.join();
 }
 
-void NodeLink::trigger(std::uint64_t number) noexcept {
+void NodeLink::trigger(std::uint64_t number, std::int64_t at_ns) noexcept {
   if (number < next_trigger_) return;  // another camera posted it
   next_trigger_ = number + 1;
-  (void)triggers_->try_push(number);  // 1024 deep: full only when DDS stalls (then lost)
+  (void)triggers_->try_push(Posted{number, at_ns});  // 1024 deep: full only when DDS stalls
   trigger_bell_.ring();
 }
 
 void NodeLink::trigger_loop() noexcept {
   while (!stop_.load(std::memory_order_acquire)) {
     const std::uint32_t seen = trigger_bell_.snapshot();
-    std::uint64_t n = 0;
-    if (!triggers_->try_pop(n)) {
+    Posted p;
+    if (!triggers_->try_pop(p)) {
       trigger_bell_.wait(seen, 10'000'000);
       continue;
     }
-    const mocap_node_Trigger t{n, realtime_ns()};
+    const std::int64_t sent = realtime_ns();
+    // The instant on CLOCK_REALTIME, the clock the nodes share (PTP).
+    const std::int64_t fire = p.at_ns != 0 ? p.at_ns + (sent - monotonic_ns()) : 0;
+    fire_rt_[p.number % std::size(fire_rt_)].store(fire, std::memory_order_relaxed);
+    const mocap_node_Trigger t{p.number, sent, fire};
     if (dds_write(writer_, &t) >= 0) triggers_sent_.add();
   }
 }
@@ -200,7 +207,10 @@ void NodeLink::on_sample(const mocap_node_BlobFrame& s) noexcept {
   if (h.sent_ns != 0) transit_.record(t3 - h.sent_ns);
   if (h.trigger_sent_ns != 0 && h.trigger_received_ns != 0 && h.sent_ns != 0) {
     trigger_leg_.record(h.trigger_received_ns - h.trigger_sent_ns);
-    node_work_.record(h.sent_ns - h.trigger_received_ns);
+    // The node's leg starts when the trigger took effect: on arrival, or at its instant.
+    const std::int64_t fire =
+        fire_rt_[h.frame_number % std::size(fire_rt_)].load(std::memory_order_relaxed);
+    node_work_.record(h.sent_ns - std::max(h.trigger_received_ns, fire));
   }
   if ((h.flags & kWireEndOfStream) == 0 &&
       h.frame_number + 1 > received_end_.load(std::memory_order_relaxed))  // single writer

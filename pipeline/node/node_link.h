@@ -8,12 +8,18 @@
 //     inbox (rt::SlotPool, receiver -> capture thread; inbox full: counted, dropped),
 //     estimates the node's clock offset and rings the inbox doorbell;
 //   - the trigger thread (`mocap-ntrig`, SCHED_FIFO kDdsFifoPriority when realtime): writes
-//   mocap/trigger for every central trigger
-//     the capture thread posts (trigger(): an SPSC ring, never DDS on the capture thread).
+//     mocap/trigger for every central trigger the capture thread posts (trigger(): an SPSC
+//     ring, never DDS on the capture thread). With a trigger lead (node.trigger_lead_us) the
+//     capture thread posts each trigger that long before its instant, and the message
+//     carries the instant (`fire_ns`, CLOCK_REALTIME): the nodes fire their cameras then,
+//     together, whatever the trigger's way took (a scheduled trigger, as GigE Vision's
+//     scheduled action commands: the exposures of all nodes start within their clocks'
+//     synchronisation, and the trigger's way is off the frame's latency).
 // Clock offset per node (CLOCK_REALTIME, node minus central), NTP-style from a trigger's
 // round trip: t0 central sent, t1 node received, t2 node sent, t3 central received:
 // offset = ((t1 - t0) + (t2 - t3)) / 2, round trip = (t3 - t0) - (t2 - t1); the sample
 // with the smallest round trip of the last 256 wins. Without triggers: t2 - t3 (one way).
+// node_work (the node's leg) starts at the later of t1 and the trigger's instant.
 // start() waits (bounded) until every node of the configuration was discovered.
 #pragma once
 
@@ -53,8 +59,10 @@ struct NodeStats {
 class NodeLink {
  public:
   // realtime: its threads and Cyclone's receive thread at SCHED_FIFO kDdsFifoPriority.
+  // trigger_lead_ns: how long before its instant a central trigger is posted (0: at it).
   static Expected<std::shared_ptr<NodeLink>> create(std::uint32_t domain_id, double wait_s,
-                                                    bool realtime);
+                                                    bool realtime,
+                                                    std::int64_t trigger_lead_ns = 0);
   ~NodeLink();
 
   // Setup (before start): camera `camera` of node `node`; its inbox holds `slots`
@@ -72,9 +80,10 @@ class NodeLink {
   void stop() noexcept;
   const std::string& notice() const noexcept { return notice_; }
 
-  // Capture thread: posts central trigger `number` (once: later calls with the same or a
-  // lower number are ignored).
-  void trigger(std::uint64_t number) noexcept;
+  // Capture thread: posts central trigger `number`, to fire at `at_ns` (CLOCK_MONOTONIC;
+  // 0: when it arrives) once: later calls with the same or a lower number are ignored.
+  void trigger(std::uint64_t number, std::int64_t at_ns) noexcept;
+  std::int64_t trigger_lead_ns() const noexcept { return trigger_lead_ns_; }
 
   // Any thread: the highest frame number + 1 any camera's (valid, not end-of-stream)
   // message carried. A NodeCamera declares a frame missing only below it: some node got
@@ -118,7 +127,16 @@ class NodeLink {
   std::vector<std::unique_ptr<rt::SlotPool<Received>>> inboxes_;
   std::vector<std::unique_ptr<rt::Counter>> full_;
   std::vector<std::int64_t> spare_;  // receiver: an acquired, unpublished slot or -1
-  std::unique_ptr<rt::SpscRing<std::uint64_t>> triggers_;
+  struct Posted {
+    std::uint64_t number = 0;
+    std::int64_t at_ns = 0;  // CLOCK_MONOTONIC, 0: on arrival
+  };
+  std::unique_ptr<rt::SpscRing<Posted>> triggers_;
+  std::int64_t trigger_lead_ns_ = 0;
+  // The trigger thread's fire_ns of trigger k at k % 256, for the receiver's node_work
+  // (relaxed: a statistic; the echo arrives long after the write, 256 triggers never wrap
+  // within a message's round trip).
+  std::atomic<std::int64_t> fire_rt_[256] = {};
   std::uint64_t next_trigger_ = 0;  // capture thread: the lowest number not yet posted
   pipeline::Doorbell bell_, trigger_bell_;
   std::atomic<bool> stop_{false};

@@ -7,6 +7,7 @@
 #include <cstdio>
 
 #include "core/clock.h"
+#include "rt/cpu_relax.h"
 
 namespace mocap::node {
 
@@ -78,6 +79,7 @@ Expected<void> NodeRunner::start() {
   }
   for (auto& s : states_) {
     s->ended = false;
+    s->has_staged = false;
     s->held.store(false, std::memory_order_relaxed);  // no thread runs yet
   }
   running_ = true;
@@ -140,19 +142,38 @@ std::string NodeRunner::report() const {
   return out;
 }
 
-void NodeRunner::take_triggers(int c) noexcept {
+std::int64_t NodeRunner::take_triggers(int c) noexcept {
   CamState& st = *states_[static_cast<std::size_t>(c)];
   hal::Camera& cam = *cams_[static_cast<std::size_t>(c)].camera;
-  TriggerStamp t;
-  while (st.count < std::size(st.pending) && sender_.triggers(c).try_pop(t)) {
+  for (;;) {
+    if (!st.has_staged) {
+      if (st.count >= std::size(st.pending) || !sender_.triggers(c).try_pop(st.staged))
+        return kNoInstant;
+      st.has_staged = true;
+    }
+    // A scheduled trigger waits for its instant (the triggers behind it too: in order).
+    if (st.staged.fire_ns != 0 && st.staged.fire_ns > monotonic_ns()) return st.staged.fire_ns;
+    st.has_staged = false;
     if (cam.trigger() != hal::CameraStatus::kOk) {
       st.errors.add();
       continue;
     }
     st.triggers.add();
-    st.pending[(st.head + st.count) % std::size(st.pending)] = t;
+    st.pending[(st.head + st.count) % std::size(st.pending)] = st.staged;
     ++st.count;
   }
+}
+
+void NodeRunner::wait_for(pipeline::Doorbell& bell, std::uint32_t seen,
+                          std::int64_t instant_ns) noexcept {
+  // Asleep until kFireSpinNs before the instant (a trigger or the stop rings earlier),
+  // then spinning, so the cameras fire at the instant and not a wake-up later.
+  const std::int64_t asleep_ns = instant_ns - kFireSpinNs - monotonic_ns();
+  if (asleep_ns > 0) {
+    bell.wait(seen, asleep_ns);
+    return;  // the caller looks again
+  }
+  while (monotonic_ns() < instant_ns && !stop_.load(std::memory_order_acquire)) rt::cpu_relax();
 }
 
 void NodeRunner::send(int c, const hal::Frame* f, std::uint16_t flags,
@@ -247,12 +268,13 @@ void NodeRunner::work() noexcept {
   pipeline::Doorbell& bell = sender_.trigger_bell();
   while (!stop_.load(std::memory_order_acquire)) {
     const std::uint32_t seen = bell.snapshot();
-    // Every pending trigger first (the exposures start together), then one frame per
-    // camera; a camera held by another worker is that worker's.
+    // Every pending trigger whose instant came first (the exposures start together), then
+    // one frame per camera; a camera held by another worker is that worker's.
     // The camera's state (ended included) is read and written only by its holder.
+    std::int64_t next_instant = kNoInstant;
     for (const int c : central_) {
       if (!claim(c)) continue;
-      if (!state(c).ended) take_triggers(c);
+      if (!state(c).ended) next_instant = std::min(next_instant, take_triggers(c));
       unclaim(c);
     }
     bool played = false;
@@ -264,6 +286,8 @@ void NodeRunner::work() noexcept {
     // One wake-up of the sender for the frames of this pass: it writes them together.
     if (played)
       sender_.wake();
+    else if (next_instant != kNoInstant)
+      wait_for(bell, seen, next_instant);
     else
       bell.wait(seen, 10'000'000);
   }

@@ -12,7 +12,11 @@
 // wake-ups and datagrams than one per camera; the frame set waits for its last camera
 // anyway). A worker that played a frame looks again before it sleeps, so a trigger that
 // arrived while another worker held its camera is never left waiting; a worker that wakes
-// late leaves its cameras to the others.
+// late leaves its cameras to the others. A trigger the central scheduled (its instant,
+// node.trigger_lead_us ahead) is fired at its instant, not on arrival: the worker sleeps
+// until kFireSpinNs before it and spins the rest, so every camera of every node starts
+// its exposure at the instant (within the clocks' synchronisation); one that arrives
+// after its instant fires at once.
 // Every other camera (its own software grid, external trigger, free run: its frames come
 // on its own timing, and a blocking dequeue is its wait) has a thread of its own
 // (`mocap-node<k>`). Each camera keeps its own BlobDetector, staging message and counters.
@@ -32,6 +36,7 @@
 #pragma once
 
 #include <atomic>
+#include <climits>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -89,8 +94,14 @@ class NodeRunner {
   std::string report() const;                        // one line per camera (report time)
 
  private:
+  static constexpr std::int64_t kNoInstant = INT64_MAX;
+  // The timer wake-up margin of a scheduled trigger: spinning costs a worker at most this
+  // per trigger (2 % of a core at 100 Hz); a wake-up later than this fires late.
+  static constexpr std::int64_t kFireSpinNs = 200'000;
   struct CamState {
     rt::Counter frames, errors, timeouts, overflow, triggers, behind;
+    TriggerStamp staged;  // popped, its instant still ahead (has_staged)
+    bool has_staged = false;
     TriggerStamp pending[64];  // central triggers sent to the camera, oldest first
     std::uint32_t head = 0, count = 0;
     bool behind_noted = false;  // behind counted for pending[head]
@@ -111,7 +122,11 @@ class NodeRunner {
   bool play(int c) noexcept;  // a held central camera's next frame; false: none pending
   // The dequeue's outcome: counted, sent, released. True when the stream ended.
   bool deliver(int c, hal::CameraStatus s, hal::Frame& f) noexcept;
-  void take_triggers(int c) noexcept;
+  // Fires the camera's received triggers whose instant came, in order; returns the
+  // instant of the first one still ahead (kNoInstant: none).
+  std::int64_t take_triggers(int c) noexcept;
+  // A worker with nothing to play until instant_ns (CLOCK_MONOTONIC).
+  void wait_for(pipeline::Doorbell& bell, std::uint32_t seen, std::int64_t instant_ns) noexcept;
   void send(int c, const hal::Frame* f, std::uint16_t flags, const TriggerStamp& t) noexcept;
 
   std::vector<NodeCameraSpec> cams_;

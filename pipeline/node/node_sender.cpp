@@ -122,13 +122,25 @@ void NodeSender::take_triggers(dds_entity_t reader) noexcept {
     const dds_return_t n = dds_take(reader, samples, infos, kBatch, kBatch);
     if (n <= 0) break;
     const std::int64_t now = realtime_ns();
+    const std::int64_t mono = monotonic_ns();
     for (dds_return_t i = 0; i < n; ++i) {
       if (!infos[i].valid_data) continue;
       const auto* t = static_cast<const mocap_node_Trigger*>(samples[i]);
       triggers_in_.add();
+      // The instant on this node's CLOCK_MONOTONIC (through CLOCK_REALTIME, PTP). One past
+      // fires at once; one further ahead than any lead means the clocks disagree: it
+      // fires at once too, counted (the central's lead is bounded by kMaxTriggerLeadUs).
+      std::int64_t fire = 0;
+      if (t->fire_ns != 0 && t->fire_ns <= now) triggers_late_.add();
+      if (t->fire_ns > now) {
+        if (t->fire_ns - now <= 2 * kMaxTriggerLeadUs * 1000)
+          fire = mono + (t->fire_ns - now);
+        else
+          triggers_unsynced_.add();
+      }
       for (std::size_t c = 0; c < central_.size(); ++c) {
         if (central_[c] &&
-            !triggers_[c]->try_push(TriggerStamp{t->trigger_number, t->sent_ns, now}))
+            !triggers_[c]->try_push(TriggerStamp{t->trigger_number, t->sent_ns, now, fire}))
           triggers_dropped_.add();
       }
     }

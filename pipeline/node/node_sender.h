@@ -11,7 +11,8 @@
 //     touch DDS (it locks and allocates).
 //   - the mocap/trigger listener, called by Cyclone where it delivers a trigger (its
 //     receive thread, real-time too: node_dds.h), so no thread hop: hands each trigger
-//     (number, central send time, node receive time) to every camera with `trigger:
+//     (number, central send time, node receive time, the instant to fire at on this node's
+//     CLOCK_MONOTONIC when the central scheduled it) to every camera with `trigger:
 //     central` through its SPSC ring, then rings the detection workers' one doorbell
 //     (after every camera's push), waking up to set_trigger_wakeups() of them.
 // Setup allocates (queues of depth x 139 KiB per camera); the camera-thread side
@@ -24,6 +25,7 @@
 #include <string>
 #include <vector>
 
+#include "core/camera_set.h"
 #include "pipeline/doorbell.h"
 #include "pipeline/node/node_dds.h"
 #include "rt/counter.h"
@@ -37,6 +39,7 @@ struct TriggerStamp {
   std::uint64_t number = 0;
   std::int64_t sent_ns = 0;      // central CLOCK_REALTIME
   std::int64_t received_ns = 0;  // node CLOCK_REALTIME
+  std::int64_t fire_ns = 0;      // node CLOCK_MONOTONIC instant to fire at; 0: at once
 };
 
 class NodeSender {
@@ -69,6 +72,12 @@ class NodeSender {
   std::uint64_t write_errors() const noexcept { return write_errors_.get(); }
   std::uint64_t triggers_received() const noexcept { return triggers_in_.get(); }
   std::uint64_t triggers_dropped() const noexcept { return triggers_dropped_.get(); }
+  // Triggers whose instant lay beyond 2 x kMaxTriggerLeadUs ahead (clocks apart): fired
+  // on arrival.
+  std::uint64_t triggers_unsynced() const noexcept { return triggers_unsynced_.get(); }
+  // Scheduled triggers that arrived after their instant (the lead was shorter than the
+  // trigger's way): fired on arrival.
+  std::uint64_t triggers_late() const noexcept { return triggers_late_.get(); }
   // Matched central readers of mocap/blobs (0 when unknown).
   std::uint32_t matched_readers() const noexcept;
 
@@ -93,7 +102,8 @@ class NodeSender {
   pipeline::Doorbell bell_;
   std::atomic<bool> stop_{false};
   rt::RtThread send_thread_;
-  rt::Counter sent_, write_errors_, triggers_in_, triggers_dropped_;
+  rt::Counter sent_, write_errors_, triggers_in_, triggers_dropped_, triggers_unsynced_,
+      triggers_late_;
 };
 
 }  // namespace mocap::node

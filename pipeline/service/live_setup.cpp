@@ -208,7 +208,8 @@ Expected<std::unique_ptr<LiveSetup>> LiveSetup::create(const config::RunConfig& 
     assets = config::load_tracking_assets(cfg, nullptr, nullptr, nullptr, targets_required);
     if (!assets) return assets.error();
 #ifdef MOCAP_HAVE_NODES
-    auto link = node::NodeLink::create(cfg.node.domain_id, cfg.node.wait_s, cfg.pipeline.realtime);
+    auto link = node::NodeLink::create(cfg.node.domain_id, cfg.node.wait_s, cfg.pipeline.realtime,
+                                       std::int64_t{cfg.node.trigger_lead_us} * 1000);
     if (!link) return link.error();
     s->link_ = std::move(link).value();
     for (std::size_t c = 0; c < n; ++c) {

@@ -217,11 +217,14 @@ int run_node(const NodeArgs& a) {
   if (ended) std::fprintf(stderr, "mocap node: the recording ended\n");
   std::fputs((*runner)->report().c_str(), stdout);
   std::printf(
-      "sent %llu messages, %llu write errors, %llu central triggers received, %llu dropped\n",
+      "sent %llu messages, %llu write errors, %llu central triggers received, %llu dropped, "
+      "%llu after their instant, %llu with an instant too far ahead (clocks apart)\n",
       static_cast<unsigned long long>((*sender)->sent()),
       static_cast<unsigned long long>((*sender)->write_errors()),
       static_cast<unsigned long long>((*sender)->triggers_received()),
-      static_cast<unsigned long long>((*sender)->triggers_dropped()));
+      static_cast<unsigned long long>((*sender)->triggers_dropped()),
+      static_cast<unsigned long long>((*sender)->triggers_late()),
+      static_cast<unsigned long long>((*sender)->triggers_unsynced()));
   return 0;
 }
 #else

@@ -144,6 +144,9 @@ struct NodeSettings {
   // node: the detection workers of its `trigger: central` cameras (1..their count); 0: the
   // default, min(those cameras, online CPUs)
   int detect_threads = 0;
+  // central: how long before its instant a trigger is sent to the nodes (0..
+  // kMaxTriggerLeadUs, at most half a trigger period is used); the nodes fire at the instant
+  int trigger_lead_us = 1000;
 };
 
 // Which command reads the configuration: `mocap node` takes 1..8 cameras of its own PC

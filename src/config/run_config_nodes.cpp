@@ -4,7 +4,7 @@
 //                       or software-triggered camera follows the central triggers)
 //   cameras[i].camera   replay: the recording's camera NAME this camera plays
 //   cameras[i].device   node backend: NODE/CAMERA
-//   node:               {name, domain_id, timeout_ms, wait_s, detect_threads}
+//   node:               {name, domain_id, timeout_ms, wait_s, detect_threads, trigger_lead_us}
 //   pipeline.pair_by    sequence | timestamp, pipeline.pair_tolerance_us
 // Each is checked here with the one-line "FILE: key: problem" error of the reader.
 #include <string>
@@ -51,7 +51,9 @@ void read_node_camera_keys(const Section& s, config::CameraSettings& cam) {
 
 void read_node_section(const YAML::Node& node, const std::vector<config::CameraSettings>& cameras,
                        config::NodeSettings& n) {
-  const Section s(node, "node", {"name", "domain_id", "timeout_ms", "wait_s", "detect_threads"});
+  const Section s(
+      node, "node",
+      {"name", "domain_id", "timeout_ms", "wait_s", "detect_threads", "trigger_lead_us"});
   if (const auto v = s.text("name")) {
     for (char ch : *v) {
       if (ch <= ' ' || ch > '~' || ch == '/')
@@ -63,6 +65,8 @@ void read_node_section(const YAML::Node& node, const std::vector<config::CameraS
   if (const auto v = s.integer("domain_id", 0, 232)) n.domain_id = static_cast<std::uint32_t>(*v);
   if (const auto v = s.integer("timeout_ms", 1, 10'000)) n.timeout_ms = static_cast<int>(*v);
   if (const auto v = s.number("wait_s", 0.0, 3600.0)) n.wait_s = *v;
+  if (const auto v = s.integer("trigger_lead_us", 0, kMaxTriggerLeadUs))
+    n.trigger_lead_us = static_cast<int>(*v);
   if (const auto v = s.integer("detect_threads", 1, kMaxNodeCameras)) {
     std::int64_t central = 0;
     for (const config::CameraSettings& c : cameras) central += c.central_trigger ? 1 : 0;

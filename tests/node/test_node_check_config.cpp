@@ -4,8 +4,8 @@
 // and exactly one line naming the file and the key for each kind of bad input (an unknown
 // key, a backend a node cannot run, a recording camera that does not exist, two cameras
 // publishing the same name, 9 cameras: a node publishes at most 8; more detection workers
-// than central-triggered cameras, or none to serve). No DDS and no camera is
-// touched.
+// than central-triggered cameras, or none to serve; a trigger lead beyond 0.1 s). No DDS
+// and no camera is touched.
 #include <gtest/gtest.h>
 
 #include <string>
@@ -98,6 +98,10 @@ TEST(NodeCheckConfig, RejectsBadInputWithOneLineNamingFileAndKey) {
        "node: {detect_threads: 0}\ncameras:\n  - {backend: replay, device: " + rec +
            ", camera: cam1, trigger: central}\n",
        "node.detect_threads: must be in [1, 8], got 0"},
+      {"lead.yaml",
+       "node: {trigger_lead_us: 200000}\ncameras:\n  - {backend: replay, device: " + rec +
+           ", camera: cam1, trigger: central}\n",
+       "node.trigger_lead_us: must be in [0, 100000], got 200000"},
       {"no_recording.yaml",
        "cameras:\n  - {backend: replay, device: " + dir.file("nothing") + "}\n",
        "cameras[0].device: "},

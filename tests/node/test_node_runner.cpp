@@ -4,7 +4,7 @@
 // not started). The detection workers of the `trigger: central` cameras play every
 // camera's frame of every trigger, in trigger order, the replay's frame the trigger names
 // (a skipped number is seeked over), with the same blob lists whatever the worker count;
-// node.detect_threads' default and its bounds.
+// node.detect_threads' default and its bounds; a scheduled trigger fires at its instant.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -15,6 +15,7 @@
 #include <thread>
 #include <vector>
 
+#include "core/clock.h"
 #include "formats/recording.h"
 #include "hal/replay_camera.h"
 #include "pipeline/node/node_runner.h"
@@ -32,7 +33,8 @@ struct Message {
 };
 
 // `cameras` replay cameras of the fixture recording (`trigger: central`) on one node with
-// `threads` detection workers; triggers `numbers` pushed at once; each camera's messages.
+// `threads` detection workers; triggers `numbers` pushed at once (scheduled `ahead_ns[i]`
+// after the push when given: the instants go to `instants`); each camera's messages.
 class NodeRunnerTest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -42,7 +44,9 @@ class NodeRunnerTest : public ::testing::Test {
   }
   std::vector<std::vector<Message>> play(int cameras, int threads,
                                          const std::vector<std::uint64_t>& numbers,
-                                         int* workers = nullptr) {
+                                         int* workers = nullptr,
+                                         const std::vector<std::int64_t>& ahead_ns = {},
+                                         std::vector<std::int64_t>* instants = nullptr) {
     const auto domain = 1 + static_cast<std::uint32_t>((::getpid() * 11 + 5) % 231);
     auto sender = NodeSender::create(domain, std::vector<bool>(cameras, true), 8, false);
     EXPECT_TRUE(sender) << sender.error().message;
@@ -74,8 +78,12 @@ class NodeRunnerTest : public ::testing::Test {
     if (!runner) return {};
     if (workers != nullptr) *workers = (*runner)->workers();
     EXPECT_TRUE((*runner)->start());
-    for (const std::uint64_t k : numbers) {
-      for (int c = 0; c < cameras; ++c) EXPECT_TRUE((*sender)->triggers(c).try_push({k, 1, 2}));
+    const std::int64_t pushed_ns = monotonic_ns();
+    for (std::size_t i = 0; i < numbers.size(); ++i) {
+      const std::int64_t fire = ahead_ns.empty() ? 0 : pushed_ns + ahead_ns[i];
+      if (instants != nullptr) instants->push_back(fire);
+      for (int c = 0; c < cameras; ++c)
+        EXPECT_TRUE((*sender)->triggers(c).try_push({numbers[i], 1, 2, fire}));
       (*sender)->trigger_bell().ring(cameras);
     }
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
@@ -132,6 +140,32 @@ TEST_F(NodeRunnerTest, TheWorkerCountChangesNoBlob) {
       EXPECT_EQ(three[c][i].header.frame_number, numbers[i]);
       EXPECT_EQ(three[c][i].header.blob_count, one[c][i].header.blob_count);
       EXPECT_EQ(three[c][i].blobs, one[c][i].blobs) << "camera " << c << " frame " << numbers[i];
+    }
+  }
+}
+
+TEST_F(NodeRunnerTest, AScheduledTriggerFiresAtItsInstantInOrder) {
+  // Pushed together: an instant already past (fires at once), then two 200 and 400 ms
+  // ahead. Every camera's frame of a trigger is detected after its instant and before
+  // the next one's (the detection takes well under 200 ms), in order, on 1 or 2 workers.
+  for (const int threads : {1, 2}) {
+    std::vector<std::int64_t> instants;
+    const auto got =
+        play(3, threads, {0, 1, 2}, nullptr, {-5'000'000, 200'000'000, 400'000'000}, &instants);
+    ASSERT_EQ(got.size(), 3u);
+    ASSERT_EQ(instants.size(), 3u);
+    for (std::size_t c = 0; c < got.size(); ++c) {
+      ASSERT_EQ(got[c].size(), 3u) << "camera " << c;
+      for (std::size_t i = 0; i < 3; ++i) {
+        const WireHeader& h = got[c][i].header;
+        EXPECT_EQ(h.frame_number, i);
+        if (i > 0) {
+          EXPECT_GE(h.detected_ns, instants[i]) << "camera " << c << " trigger " << i;
+        }
+        if (i < 2) {
+          EXPECT_LT(h.detected_ns, instants[i + 1]) << "camera " << c << " trigger " << i;
+        }
+      }
     }
   }
 }

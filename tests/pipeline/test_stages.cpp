@@ -2,15 +2,19 @@
 // cameras: the publish stage hands the NEWEST waiting message to every sink and counts
 // the older ones as skipped, counts a sink's refusal, retires each sequence it published
 // (the ledger lockstep pacing waits on) and reports the counters it declares; the
-// context's ledger only grows and keeps the first sequence it was told.
+// context's ledger only grows and keeps the first sequence it was told. The capture stage
+// triggers a camera with a trigger lead (a camera node's) through trigger_at(instant), at
+// most its lead (and half a period) ahead of the instant, never after it, every frame.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <thread>
 
 #include "pipeline/publish_stage.h"
 #include "pipeline/stage_context.h"
+#include "tests/pipeline/pipeline_fixture.h"
 
 namespace mocap::pipeline {
 namespace {
@@ -103,6 +107,88 @@ TEST(StageContext, LedgerOnlyGrowsAndKeepsTheFirstSequence) {
   context.reset();
   EXPECT_EQ(context.retired_plus_one(), 0u);
   EXPECT_FALSE(context.stopping());
+}
+
+// Camera 0 of the simulated rig with a trigger lead: records each trigger_at() (the call
+// time and the instant; the capture thread writes, the test reads after stop()) and
+// fires the simulated trigger at once (what is checked is the capture stage's timing).
+class LeadCamera final : public hal::Camera {
+ public:
+  LeadCamera(hal::Camera& inner, std::int64_t lead_ns) : inner_(inner), lead_ns_(lead_ns) {}
+  const std::string& name() const noexcept override { return inner_.name(); }
+  hal::CameraState state() const noexcept override { return inner_.state(); }
+  Expected<void> configure(const hal::CameraConfig& c) override { return inner_.configure(c); }
+  Expected<void> start() override { return inner_.start(); }
+  void stop() noexcept override { inner_.stop(); }
+  hal::CameraStatus trigger() noexcept override {
+    plain.fetch_add(1, std::memory_order_relaxed);
+    return inner_.trigger();
+  }
+  std::int64_t trigger_lead_ns() const noexcept override { return lead_ns_; }
+  hal::CameraStatus trigger_at(std::int64_t at_ns) noexcept override {
+    const std::size_t n = count.load(std::memory_order_relaxed);  // single writer
+    if (n < calls.size()) {
+      calls[n] = {monotonic_ns(), at_ns};
+      count.store(n + 1, std::memory_order_release);
+    }
+    return inner_.trigger();
+  }
+  hal::CameraStatus dequeue(hal::Frame& f, int timeout_ms) noexcept override {
+    return inner_.dequeue(f, timeout_ms);
+  }
+  hal::CameraStatus release(const hal::Frame& f) noexcept override { return inner_.release(f); }
+  const hal::CameraConfig& config() const noexcept override { return inner_.config(); }
+  const std::string& notice() const noexcept override { return inner_.notice(); }
+  const hal::CameraCounters& counters() const noexcept override { return inner_.counters(); }
+
+  struct Call {
+    std::int64_t at_call_ns = 0, instant_ns = 0;
+  };
+  std::array<Call, 64> calls{};
+  std::atomic<std::size_t> count{0};
+  std::atomic<int> plain{0};
+
+ private:
+  hal::Camera& inner_;
+  std::int64_t lead_ns_;
+};
+
+TEST(CaptureStage, ACameraWithALeadIsTriggeredAheadOfEachInstant) {
+  // A 3 ms lead, and a 30 ms one (more than half the 10 ms period: half a period is used).
+  for (const std::int64_t lead_ns : {3'000'000LL, 30'000'000LL}) {
+    test::SimRigFixture rig;
+    LeadCamera lead(*rig.cams[0], lead_ns);
+    std::vector<hal::Camera*> cams = rig.cameras();
+    cams[0] = &lead;
+    test::RecordingSink record(64);
+    PipelineOptions opt = test::test_options();
+    opt.max_frames = 20;
+    opt.trigger_rate_hz = 100.0;
+    opt.pacing = TriggerPacing::kLockstep;
+    auto p = Pipeline::create(rig.processor(), cams, {&record}, opt);
+    ASSERT_TRUE(p.ok()) << p.error().message;
+    ASSERT_TRUE((*p)->start().ok());
+    test::wait_finished(**p);
+    (*p)->stop();
+    EXPECT_EQ(record.count(), 20u);
+    EXPECT_EQ(lead.plain.load(), 0);
+    const std::size_t n = lead.count.load(std::memory_order_acquire);
+    ASSERT_EQ(n, 20u);
+    const std::int64_t used_ns = std::min<std::int64_t>(lead_ns, 5'000'000);
+    std::vector<std::int64_t> ahead_ns;
+    for (std::size_t i = 0; i < n; ++i) {
+      const LeadCamera::Call& c = lead.calls[i];
+      ahead_ns.push_back(c.instant_ns - c.at_call_ns);
+      EXPECT_LE(ahead_ns.back(), used_ns) << "trigger " << i;  // at most the lead used
+      if (i > 0) {
+        EXPECT_GT(c.instant_ns, lead.calls[i - 1].instant_ns);
+      }
+    }
+    // Ahead by about the lead: a trigger is posted late only when the capture thread
+    // wakes late (then its instant is the posting time: it fires on arrival).
+    std::nth_element(ahead_ns.begin(), ahead_ns.begin() + 10, ahead_ns.end());
+    EXPECT_GE(ahead_ns[10], used_ns / 2) << "median lead";
+  }
 }
 
 }  // namespace
