@@ -154,8 +154,10 @@ class LeadCamera final : public hal::Camera {
 };
 
 TEST(CaptureStage, ACameraWithALeadIsTriggeredAheadOfEachInstant) {
-  // A 3 ms lead, and a 30 ms one (more than half the 10 ms period: half a period is used).
-  for (const std::int64_t lead_ns : {3'000'000LL, 30'000'000LL}) {
+  // A 3 ms lead, and a 40 ms one (more than half the 50 ms period: half a period is used).
+  // 20 Hz: the frames (sanitizers, a loaded machine) are retired well within a period, so
+  // the lockstep capture is in time for most triggers.
+  for (const std::int64_t lead_ns : {3'000'000LL, 40'000'000LL}) {
     test::SimRigFixture rig;
     LeadCamera lead(*rig.cams[0], lead_ns);
     std::vector<hal::Camera*> cams = rig.cameras();
@@ -163,7 +165,7 @@ TEST(CaptureStage, ACameraWithALeadIsTriggeredAheadOfEachInstant) {
     test::RecordingSink record(64);
     PipelineOptions opt = test::test_options();
     opt.max_frames = 20;
-    opt.trigger_rate_hz = 100.0;
+    opt.trigger_rate_hz = 20.0;
     opt.pacing = TriggerPacing::kLockstep;
     auto p = Pipeline::create(rig.processor(), cams, {&record}, opt);
     ASSERT_TRUE(p.ok()) << p.error().message;
@@ -174,7 +176,7 @@ TEST(CaptureStage, ACameraWithALeadIsTriggeredAheadOfEachInstant) {
     EXPECT_EQ(lead.plain.load(), 0);
     const std::size_t n = lead.count.load(std::memory_order_acquire);
     ASSERT_EQ(n, 20u);
-    const std::int64_t used_ns = std::min<std::int64_t>(lead_ns, 5'000'000);
+    const std::int64_t used_ns = std::min<std::int64_t>(lead_ns, 25'000'000);
     std::vector<std::int64_t> ahead_ns;
     for (std::size_t i = 0; i < n; ++i) {
       const LeadCamera::Call& c = lead.calls[i];
