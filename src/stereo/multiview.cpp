@@ -125,12 +125,12 @@ void MultiViewMerger::refine(int i, const Vec2* const* px) noexcept {
     if (k < 3) return;  // two views: the pair's optimal (niter2) point stands
     Vec3 X = h.X_world;
     double rms = 0.0;
-    if (!refine_gauss_newton(cams, obs, k, X, rms, kRefineIterations, kStepToleranceMm)) return;
+    double r2[kMaxCameras];  // each view's squared residual at X (the RMS's evaluation)
+    if (!refine_gauss_newton(cams, obs, k, X, rms, kRefineIterations, kStepToleranceMm, r2)) return;
     int worst = -1;
     double worst_d = config_.gate_px;
     for (int v = 0; v < k; ++v) {
-      Vec2 q;
-      const double d = project(*cams[v], X, q) ? (q - obs[v]).norm() : 1e300;
+      const double d = std::sqrt(r2[v]);
       if (d > worst_d) {
         worst_d = d;
         worst = v;
