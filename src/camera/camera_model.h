@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "core/mat3_product.h"
 #include "core/types.h"
 
 namespace mocap {
@@ -36,17 +37,10 @@ struct Rig {
 };
 
 // World -> camera coordinates, X_cam = R_cam_world * X_world + t_cam_world, written out
-// (the N-view merge's and the shape check's projections; Eigen evaluated the product into
-// a temporary through an out-of-line call). The same sums in the same order as Eigen's
-// fixed-size product: rows 0 and 1 from the left, row 2 its first term plus the sum of
-// the other two; bit for bit the same result (tests/camera/test_camera.cpp checks).
+// (core/mat3_product.h: bit for bit Eigen's expression, without its out-of-line
+// temporary) for the N-view merge's and the shape check's projections.
 inline Vec3 to_camera(const CameraModel& cam, const Vec3& X_world) noexcept {
-  const Mat3& R = cam.R_cam_world;
-  const Vec3& t = cam.t_cam_world;
-  const double x = X_world.x(), y = X_world.y(), z = X_world.z();
-  return Vec3((R(0, 0) * x + R(0, 1) * y + R(0, 2) * z) + t.x(),
-              (R(1, 0) * x + R(1, 1) * y + R(1, 2) * z) + t.y(),
-              (R(2, 0) * x + (R(2, 1) * y + R(2, 2) * z)) + t.z());
+  return mul(cam.R_cam_world, X_world) + cam.t_cam_world;
 }
 
 // Normalised undistorted (x', y') -> normalised distorted (x'', y''). Inline with the

@@ -16,6 +16,8 @@
 #include <string>
 #include <utility>
 
+#include "core/mat3_product.h"
+
 namespace mocap {
 namespace {
 
@@ -159,7 +161,7 @@ void StereoTriangulator::try_pair(int i, int j, PointList& out, int capacity) no
     return;
   }
   const double z_a = X_a.z();
-  const double z_b = (geometry_.R_10 * X_a + geometry_.t_10).z();
+  const double z_b = mul(geometry_.R_10, X_a).z() + geometry_.t_10.z();
   if (!(z_a > 0.0 && z_b > 0.0)) {
     ++counters_.rejected_cheirality;
     return;
@@ -169,7 +171,7 @@ void StereoTriangulator::try_pair(int i, int j, PointList& out, int capacity) no
     ++counters_.rejected_depth;
     return;
   }
-  const Vec3 X_world = geometry_.R_0w.transpose() * (X_a - geometry_.t_0w);
+  const Vec3 X_world = mul_transposed(geometry_.R_0w, X_a - geometry_.t_0w);
   double rms_px = 0.0;
   if (!reprojection_rms_px(cam_a_model_, cam_b_model_, X_world, a.px, b.px, rms_px)) {
     ++counters_.rejected_cheirality;
