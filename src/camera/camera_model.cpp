@@ -22,7 +22,7 @@ Eigen::Matrix2d distort_jacobian(const CameraModel& cam, const Vec2& xn) noexcep
 }
 
 bool project(const CameraModel& cam, const Vec3& X_world, Vec2& px) noexcept {
-  const Vec3 Xc = cam.R_cam_world * X_world + cam.t_cam_world;
+  const Vec3 Xc = to_camera(cam, X_world);
   if (!(Xc.z() > 1e-9)) return false;
   px = normalized_to_pixel(cam, Vec2(Xc.x() / Xc.z(), Xc.y() / Xc.z()));
   return true;

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "core/mat3_product.h"
 #include "core/types.h"
 
 namespace mocap {
@@ -34,6 +35,13 @@ struct CameraModel {
 struct Rig {
   std::vector<CameraModel> cameras;  // the first two form the stereo pair
 };
+
+// World -> camera coordinates, X_cam = R_cam_world * X_world + t_cam_world, written out
+// (core/mat3_product.h: bit for bit Eigen's expression, without its out-of-line
+// temporary) for the N-view merge's and the shape check's projections.
+inline Vec3 to_camera(const CameraModel& cam, const Vec3& X_world) noexcept {
+  return mul(cam.R_cam_world, X_world) + cam.t_cam_world;
+}
 
 // Normalised undistorted (x', y') -> normalised distorted (x'', y''). Inline with the
 // pixel mapping and project() below: the N-view merge projects thousands of points per
@@ -68,7 +76,7 @@ bool project(const CameraModel& cam, const Vec3& X_world, Vec2& px,
 inline bool project_jacobian(const CameraModel& cam, const Vec3& X_world, Vec2& px,
                              double* J) noexcept {
   const Mat3& R = cam.R_cam_world;
-  const Vec3 Xc = R * X_world + cam.t_cam_world;
+  const Vec3 Xc = to_camera(cam, X_world);
   if (!(Xc.z() > 1e-9)) return false;
   const double iz = 1.0 / Xc.z();
   const double x = Xc.x() * iz, y = Xc.y() * iz;

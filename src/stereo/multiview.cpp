@@ -69,7 +69,7 @@ MultiViewMerger::MultiViewMerger(const Rig& rig, const MultiViewConfig& config,
 
 double MultiViewMerger::unfit_gate_px(int c, const Vec3& X_world) const noexcept {
   const CameraModel& cam = cams_[static_cast<std::size_t>(c)];
-  const double z = (cam.R_cam_world * X_world + cam.t_cam_world).z();
+  const double z = to_camera(cam, X_world).z();
   if (!(z > 0.0)) return 0.0;
   return unfit_gate_at_depth_px(c, z);
 }
@@ -88,7 +88,7 @@ void MultiViewMerger::extend(int i) noexcept {
     if (h.blob_index[c] >= 0 || grid.size() == 0) continue;  // no blob: nothing to find
     // project() and unfit_gate_px() from one camera-frame point (the same values).
     const CameraModel& cam = cams_[static_cast<std::size_t>(c)];
-    const Vec3 Xc = cam.R_cam_world * h.X_world + cam.t_cam_world;
+    const Vec3 Xc = to_camera(cam, h.X_world);
     if (!(Xc.z() > 1e-9)) continue;  // behind
     const Vec2 q = normalized_to_pixel(cam, Vec2(Xc.x() / Xc.z(), Xc.y() / Xc.z()));
     const double wide = std::max(config_.gate_px, unfit_gate_at_depth_px(c, Xc.z()));
@@ -125,12 +125,12 @@ void MultiViewMerger::refine(int i, const Vec2* const* px) noexcept {
     if (k < 3) return;  // two views: the pair's optimal (niter2) point stands
     Vec3 X = h.X_world;
     double rms = 0.0;
-    if (!refine_gauss_newton(cams, obs, k, X, rms, kRefineIterations, kStepToleranceMm)) return;
+    double r2[kMaxCameras];  // each view's squared residual at X (the RMS's evaluation)
+    if (!refine_gauss_newton(cams, obs, k, X, rms, kRefineIterations, kStepToleranceMm, r2)) return;
     int worst = -1;
     double worst_d = config_.gate_px;
     for (int v = 0; v < k; ++v) {
-      Vec2 q;
-      const double d = project(*cams[v], X, q) ? (q - obs[v]).norm() : 1e300;
+      const double d = std::sqrt(r2[v]);
       if (d > worst_d) {
         worst_d = d;
         worst = v;

@@ -38,7 +38,8 @@ bool triangulate_linear_nview(const CameraModel* const* cams, const Vec2* xn, in
 }
 
 bool refine_gauss_newton(const CameraModel* const* cams, const Vec2* px, int n, Vec3& X_world,
-                         double& rms_px, int max_iterations, double step_tolerance_mm) noexcept {
+                         double& rms_px, int max_iterations, double step_tolerance_mm,
+                         double* r2_px) noexcept {
   if (n < 1 || n > kMaxCameras) return false;
   Vec3 X = X_world;
   bool last = max_iterations <= 0;
@@ -51,7 +52,9 @@ bool refine_gauss_newton(const CameraModel* const* cams, const Vec2* px, int n, 
       double J[6];
       if (!project_jacobian(*cams[k], X, p, last ? nullptr : J)) return false;
       const Vec2 r = p - px[k];
-      sq += r.squaredNorm();
+      const double r2 = r.squaredNorm();
+      sq += r2;
+      if (r2_px != nullptr) r2_px[k] = r2;
       if (last) continue;
       const double* u = J;
       const double* v = J + 3;

@@ -18,9 +18,11 @@ bool triangulate_linear_nview(const CameraModel* const* cams, const Vec2* xn, in
 
 // Minimises sum_k |project(cams[k], X) - px[k]|^2 starting from X_world (in/out).
 // Stops when a step is below step_tolerance_mm or after max_iterations. Writes the final
-// RMS reprojection error (px). Returns false when a camera sees the point behind it.
+// RMS reprojection error (px) and, when r2_px is non-null, each view's squared
+// reprojection error at the returned X_world (r2_px[k], px^2; the same evaluation as the
+// RMS). Returns false when a camera sees the point behind it.
 bool refine_gauss_newton(const CameraModel* const* cams, const Vec2* px, int n, Vec3& X_world,
-                         double& rms_px, int max_iterations = 10,
-                         double step_tolerance_mm = 1e-9) noexcept;
+                         double& rms_px, int max_iterations = 10, double step_tolerance_mm = 1e-9,
+                         double* r2_px = nullptr) noexcept;
 
 }  // namespace mocap

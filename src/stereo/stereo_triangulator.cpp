@@ -16,6 +16,8 @@
 #include <string>
 #include <utility>
 
+#include "core/mat3_product.h"
+
 namespace mocap {
 namespace {
 
@@ -75,6 +77,8 @@ Expected<StereoTriangulator> StereoTriangulator::create(const Rig& rig, const St
   if (std::abs(bdir.x()) > 0.9) seed = Vec3::UnitY();
   t.plane_u_0_ = bdir.cross(seed).normalized();
   t.plane_v_0_ = bdir.cross(t.plane_u_0_);
+  t.plane_u_1_ = t.geometry_.R_10 * t.plane_u_0_;
+  t.plane_v_1_ = t.geometry_.R_10 * t.plane_v_0_;
   auto ua = BlobUndistorter::create(ca, c.max_points_per_camera);
   auto ub = BlobUndistorter::create(cb, c.max_points_per_camera);
   if (!ua) return ua.error();
@@ -110,15 +114,17 @@ void StereoTriangulator::prepare(const UndistortedBlobs& blobs, int n, int camer
     // The ray in camera-a coordinates (its length does not change the plane).
     Vec3 r(xn.x(), xn.y(), 1.0);
     if (camera == 1) {  // camera b's blobs are only searched: no window
-      r = geometry_.R_10.transpose() * r;
-      o.key = plane_key(r.dot(plane_u_0_), r.dot(plane_v_0_));
+      // (R_10^T r).u = r.(R_10 u): the pair's plane basis turned into camera b once.
+      o.key = plane_key(r.dot(plane_u_1_), r.dot(plane_v_1_));
       continue;
     }
+    // Camera a's own key is never compared (only camera b's are searched): not computed.
     r.normalize();
     const double p = r.dot(plane_u_0_);
     const double q = r.dot(plane_v_0_);
-    o.key = plane_key(p, q);
-    const double rho = std::hypot(p, q);
+    // |(p, q)| <= 1 (a unit ray): no overflow or underflow to guard against (std::hypot's
+    // care), and the window's margins cover far more than its last-bit rounding.
+    const double rho = std::sqrt(p * p + q * q);
     // Safety margins for rounding: the window only has to be conservative (its sine
     // widened, and once more for the rotation and the keys' own rounding).
     const double s = config_.epipolar_tolerance_px * (1.0 + 1e-9) / (f_min * rho) + 1e-12;
@@ -155,7 +161,7 @@ void StereoTriangulator::try_pair(int i, int j, PointList& out, int capacity) no
     return;
   }
   const double z_a = X_a.z();
-  const double z_b = (geometry_.R_10 * X_a + geometry_.t_10).z();
+  const double z_b = mul(geometry_.R_10, X_a).z() + geometry_.t_10.z();
   if (!(z_a > 0.0 && z_b > 0.0)) {
     ++counters_.rejected_cheirality;
     return;
@@ -165,7 +171,7 @@ void StereoTriangulator::try_pair(int i, int j, PointList& out, int capacity) no
     ++counters_.rejected_depth;
     return;
   }
-  const Vec3 X_world = geometry_.R_0w.transpose() * (X_a - geometry_.t_0w);
+  const Vec3 X_world = mul_transposed(geometry_.R_0w, X_a - geometry_.t_0w);
   double rms_px = 0.0;
   if (!reprojection_rms_px(cam_a_model_, cam_b_model_, X_world, a.px, b.px, rms_px)) {
     ++counters_.rejected_cheirality;

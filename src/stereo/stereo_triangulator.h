@@ -143,6 +143,8 @@ class StereoTriangulator {
   StereoGeometry geometry_;
   Vec3 plane_u_0_ = Vec3::Zero();  // orthonormal pair perpendicular to the baseline
   Vec3 plane_v_0_ = Vec3::Zero();
+  Vec3 plane_u_1_ = Vec3::Zero();  // the same pair in camera-b coordinates (R_10 u, R_10 v)
+  Vec3 plane_v_1_ = Vec3::Zero();
   int cam_a_ = 0;
   int cam_b_ = 1;
   BlobUndistorter undistort_a_;  // for process() from distorted pixels

@@ -19,6 +19,8 @@
 #include <Eigen/SVD>
 #include <cmath>
 
+#include "core/mat3_product.h"
+
 namespace mocap {
 namespace {
 
@@ -68,9 +70,9 @@ void epipolar_distances_px(const StereoGeometry& g, const Vec2& s0, const Vec2& 
                            double& d1) noexcept {
   const Vec3 a(s0.x(), s0.y(), 1.0);
   const Vec3 b(s1.x(), s1.y(), 1.0);
-  const Vec3 l1 = g.F_s * a;              // line in image 1
-  const Vec3 l0 = g.F_s.transpose() * b;  // line in image 0
-  const double c = b.dot(l1);             // == a.dot(l0)
+  const Vec3 l1 = mul(g.F_s, a);             // line in image 1
+  const Vec3 l0 = mul_transposed(g.F_s, b);  // line in image 0
+  const double c = b.dot(l1);                // == a.dot(l0)
   const double n1 = l1.head<2>().norm();
   const double n0 = l0.head<2>().norm();
   d1 = n1 > 0.0 ? std::abs(c) / n1 : HUGE_VAL;
@@ -82,8 +84,8 @@ void niter2_correct(const Mat3& F, const Vec2& s0, const Vec2& s1, Vec2& s0c, Ve
   constexpr double kConvergedPx = 1e-10;
   const Vec3 a(s0.x(), s0.y(), 1.0);
   const Vec3 b(s1.x(), s1.y(), 1.0);
-  const Vec3 Fa = F * a;
-  const Vec3 Ftb = F.transpose() * b;
+  const Vec3 Fa = mul(F, a);
+  const Vec3 Ftb = mul_transposed(F, b);
   const Eigen::Matrix2d E2 = F.topLeftCorner<2, 2>();
   const Vec2 n_a = Ftb.head<2>();
   const Vec2 n_b = Fa.head<2>();
@@ -132,7 +134,7 @@ bool intersect_rays(const StereoGeometry& g, const Vec2& xn0c, const Vec2& xn1c,
                     Vec3& X_cam0) noexcept {
   const Vec3 x0(xn0c.x(), xn0c.y(), 1.0);
   const Vec3 x1(xn1c.x(), xn1c.y(), 1.0);
-  const Vec3 d = g.R_10 * x0;  // ray 0 direction in camera-1 coordinates
+  const Vec3 d = mul(g.R_10, x0);  // ray 0 direction in camera-1 coordinates
   const Vec3 w = x1.cross(d);
   const double w2 = w.squaredNorm();
   if (!(w2 > 1e-24 * x1.squaredNorm() * d.squaredNorm())) return false;

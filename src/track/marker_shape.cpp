@@ -60,7 +60,7 @@ Expected<MarkerShapeModel> MarkerShapeModel::create(const CameraModel& cam,
 
 bool MarkerShapeModel::silhouette(const Vec3& X_world, Eigen::Matrix2d& S, Vec2& x0,
                                   double& dist_mm) const noexcept {
-  const Vec3 C = cam_.R_cam_world * X_world + cam_.t_cam_world;
+  const Vec3 C = to_camera(cam_, X_world);
   dist_mm = C.norm();
   if (!(C.z() > radius_mm_) || !(dist_mm > radius_mm_)) return false;
   // Cone of the silhouette: x^T Q x = 0 with Q = c c^T - cos^2(alpha) I, x = (u, v, 1).

@@ -327,6 +327,19 @@ TEST(NView, LinearAndGaussNewtonRecoverThePoint) {
       grad += J.transpose() * (p - noisy[k]);
     }
     EXPECT_LT(grad.norm(), 1e-6);
+    // Each view's squared residual, from the same final evaluation as the RMS.
+    double r2[3] = {-1.0, -1.0, -1.0};
+    Vec3 Xr = Xl;
+    double rms_r = 0.0;
+    ASSERT_TRUE(refine_gauss_newton(cams, noisy, 3, Xr, rms_r, 20, 1e-9, r2));
+    EXPECT_EQ(Xr, Xg);
+    EXPECT_EQ(rms_r, rms);
+    EXPECT_EQ(std::sqrt((r2[0] + r2[1] + r2[2]) / 3.0), rms);
+    for (int k = 0; k < 3; ++k) {
+      Vec2 p;
+      ASSERT_TRUE(project(*cams[k], Xr, p));
+      EXPECT_NEAR(r2[k], (p - noisy[k]).squaredNorm(), 1e-9 * (1.0 + r2[k]));
+    }
   }
 }
 
