@@ -4,14 +4,18 @@
 // (the ledger lockstep pacing waits on) and reports the counters it declares; the
 // context's ledger only grows and keeps the first sequence it was told. The capture stage
 // triggers a camera with a trigger lead (a camera node's) through trigger_at(instant), at
-// most its lead (and half a period) ahead of the instant, never after it, every frame.
+// most its lead (and half a period) ahead of the instant, never after it, every frame. A
+// camera that delivers blobs (a camera node's) has no detect thread: the capture thread
+// hands its blobs on, and the angles equal those of the same frames detected here.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <optional>
 #include <thread>
 
+#include "detect/blob_detector.h"
 #include "pipeline/publish_stage.h"
 #include "pipeline/stage_context.h"
 #include "tests/pipeline/pipeline_fixture.h"
@@ -190,6 +194,106 @@ TEST(CaptureStage, ACameraWithALeadIsTriggeredAheadOfEachInstant) {
     // wakes late (then its instant is the posting time: it fires on arrival).
     std::nth_element(ahead_ns.begin(), ahead_ns.begin() + 10, ahead_ns.end());
     EXPECT_GE(ahead_ns[10], used_ns / 2) << "median lead";
+  }
+}
+
+// A simulated camera whose frames also carry their blobs, detected in dequeue() with the
+// tracker's own detector configuration (as a camera node's frames arrive detected).
+class BlobCamera final : public hal::Camera {
+ public:
+  explicit BlobCamera(hal::Camera& inner) : inner_(inner) {
+    const hal::CameraConfig& c = inner.config();
+    auto d = detect::BlobDetector::create(TrackerConfig{}.detect, c.width, c.height);
+    EXPECT_TRUE(d.ok());
+    for (int b = 0; b < c.buffer_count; ++b) lists_.push_back(d->make_blob_list());
+    detector_.emplace(std::move(d).value());
+  }
+  const std::string& name() const noexcept override { return inner_.name(); }
+  hal::CameraState state() const noexcept override { return inner_.state(); }
+  Expected<void> configure(const hal::CameraConfig& c) override { return inner_.configure(c); }
+  Expected<void> start() override { return inner_.start(); }
+  void stop() noexcept override { inner_.stop(); }
+  hal::CameraStatus trigger() noexcept override { return inner_.trigger(); }
+  bool delivers_blobs() const noexcept override { return true; }
+  hal::CameraStatus dequeue(hal::Frame& f, int timeout_ms) noexcept override {
+    const hal::CameraStatus s = inner_.dequeue(f, timeout_ms);
+    if (s == hal::CameraStatus::kOk && !f.missing && !f.image.empty()) {
+      detect::BlobList& list = lists_[f.buffer_index % lists_.size()];
+      list.clear();
+      (void)detector_->detect(f.image, list);
+      f.blobs = &list;
+    }
+    return s;
+  }
+  hal::CameraStatus release(const hal::Frame& f) noexcept override { return inner_.release(f); }
+  const hal::CameraConfig& config() const noexcept override { return inner_.config(); }
+  const std::string& notice() const noexcept override { return inner_.notice(); }
+  const hal::CameraCounters& counters() const noexcept override { return inner_.counters(); }
+
+ private:
+  hal::Camera& inner_;
+  std::optional<detect::BlobDetector> detector_;
+  std::vector<detect::BlobList> lists_;
+};
+
+// Which stage threads ran (any thread writes, the test reads after stop()).
+class StartedHooks final : public StageHooks {
+ public:
+  void on_loop_start(StageId s) noexcept override {
+    started_[index(s)].store(true, std::memory_order_relaxed);
+  }
+  void on_loop_end(StageId) noexcept override {}
+  bool started(StageId s) const { return started_[index(s)].load(std::memory_order_relaxed); }
+
+ private:
+  std::array<std::atomic<bool>, kMaxStages> started_{};
+};
+
+TEST(DetectStage, ACameraThatDeliversBlobsHasNoThreadAndTracksAsDetectedHere) {
+  constexpr std::uint64_t kFrames = 15;
+  std::vector<client::JointsMessage> got[2];
+  for (const bool blobs : {false, true}) {
+    test::SimRigFixture rig;
+    std::vector<std::unique_ptr<BlobCamera>> wrapped;
+    std::vector<hal::Camera*> cams = rig.cameras();
+    if (blobs) {
+      for (hal::Camera*& c : cams) {
+        wrapped.push_back(std::make_unique<BlobCamera>(*c));
+        c = wrapped.back().get();
+      }
+    }
+    test::RecordingSink record(64);
+    StartedHooks hooks;
+    PipelineOptions opt = test::test_options();
+    opt.max_frames = kFrames;
+    opt.pacing = TriggerPacing::kLockstep;  // every frame, whatever the build's speed
+    opt.hooks = &hooks;
+    auto p = Pipeline::create(rig.processor(), cams, {&record}, opt);
+    ASSERT_TRUE(p.ok()) << p.error().message;
+    ASSERT_TRUE((*p)->start().ok());
+    test::wait_finished(**p, 120.0);
+    (*p)->stop();
+    ASSERT_EQ(record.count(), kFrames);
+    for (std::size_t i = 0; i < record.count(); ++i) got[blobs ? 1 : 0].push_back(record[i]);
+    const PipelineStats st = (*p)->stats();
+    EXPECT_TRUE(hooks.started(StageId::kCapture));
+    EXPECT_TRUE(hooks.started(StageId::kIdentify));
+    for (int c = 0; c < (*p)->camera_count(); ++c) {
+      EXPECT_EQ(hooks.started(StageId::detect(c)), !blobs) << "camera " << c;
+      EXPECT_GT(test::counter(st, rt::counter_name("detect_cam#_blobs", c)), 0u);
+      EXPECT_EQ(test::counter(st, rt::counter_name("detect_cam#_frames", c)), blobs ? 0u : kFrames);
+    }
+  }
+  // The same frames (the loop from its start, lockstep) give the same angles.
+  for (std::uint64_t i = 0; i < kFrames; ++i) {
+    const client::JointsMessage& a = got[0][i];
+    const client::JointsMessage& b = got[1][i];
+    ASSERT_EQ(a.joint_count, b.joint_count);
+    EXPECT_GT(a.joint_count, 0);
+    for (int j = 0; j < a.joint_count; ++j) {
+      EXPECT_EQ(a.joints[j].valid, b.joints[j].valid) << "frame " << i << " joint " << j;
+      for (int k = 0; k < 3; ++k) EXPECT_EQ(a.joints[j].a[k], b.joints[j].a[k]);
+    }
   }
 }
 
