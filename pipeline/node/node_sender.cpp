@@ -1,6 +1,8 @@
 // Design: see node_sender.h.
 #include "pipeline/node/node_sender.h"
 
+#include <algorithm>
+
 #include "core/clock.h"
 
 namespace mocap::node {
@@ -110,6 +112,27 @@ void NodeSender::send_loop() noexcept {
   }
 }
 
+FireInstant fire_instant(std::int64_t fire_ns, std::int64_t sent_ns, std::int64_t now_rt,
+                         std::int64_t now_mono) noexcept {
+  FireInstant f;
+  if (fire_ns == 0) return f;  // not scheduled: at once
+  std::int64_t wait = fire_ns - now_rt;
+  if (wait <= 0) {
+    f.late = true;
+    return f;
+  }
+  // The central's lead, on its own clock alone: never wait longer than that after the
+  // arrival (a hostile or broken lead: at most kMaxTriggerLeadUs).
+  const std::int64_t max_wait =
+      std::clamp<std::int64_t>(fire_ns - sent_ns, 0, kMaxTriggerLeadUs * 1000);
+  if (wait > max_wait) {
+    wait = max_wait;
+    f.unsynced = true;
+  }
+  f.mono_ns = now_mono + wait;
+  return f;
+}
+
 void NodeSender::on_triggers(dds_entity_t reader, void* self) noexcept {
   static_cast<NodeSender*>(self)->take_triggers(reader);
 }
@@ -127,20 +150,12 @@ void NodeSender::take_triggers(dds_entity_t reader) noexcept {
       if (!infos[i].valid_data) continue;
       const auto* t = static_cast<const mocap_node_Trigger*>(samples[i]);
       triggers_in_.add();
-      // The instant on this node's CLOCK_MONOTONIC (through CLOCK_REALTIME, PTP). One past
-      // fires at once; one further ahead than any lead means the clocks disagree: it
-      // fires at once too, counted (the central's lead is bounded by kMaxTriggerLeadUs).
-      std::int64_t fire = 0;
-      if (t->fire_ns != 0 && t->fire_ns <= now) triggers_late_.add();
-      if (t->fire_ns > now) {
-        if (t->fire_ns - now <= 2 * kMaxTriggerLeadUs * 1000)
-          fire = mono + (t->fire_ns - now);
-        else
-          triggers_unsynced_.add();
-      }
+      const FireInstant fire = fire_instant(t->fire_ns, t->sent_ns, now, mono);
+      if (fire.late) triggers_late_.add();
+      if (fire.unsynced) triggers_unsynced_.add();
       for (std::size_t c = 0; c < central_.size(); ++c) {
         if (central_[c] &&
-            !triggers_[c]->try_push(TriggerStamp{t->trigger_number, t->sent_ns, now, fire}))
+            !triggers_[c]->try_push(TriggerStamp{t->trigger_number, t->sent_ns, now, fire.mono_ns}))
           triggers_dropped_.add();
       }
     }

@@ -15,6 +15,14 @@
 //     CLOCK_MONOTONIC when the central scheduled it) to every camera with `trigger:
 //     central` through its SPSC ring, then rings the detection workers' one doorbell
 //     (after every camera's push), waking up to set_trigger_wakeups() of them.
+// A scheduled trigger's instant (Trigger.fire_ns, the central's CLOCK_REALTIME) on this
+// node's CLOCK_MONOTONIC, through this node's CLOCK_REALTIME (PTP keeps the two
+// realtime clocks together): fire_instant(). One already past fires at once (late). The
+// node never waits longer after the arrival than the central's lead (fire_ns - sent_ns,
+// both on the central's clock; at most kMaxTriggerLeadUs): with the node's clock behind
+// the central's by more than the trigger's way, the instant would lie further ahead, and
+// it fires one lead after the arrival instead (unsynced: the exposures of the nodes then
+// differ by the trigger's way, as without a lead).
 // Setup allocates (queues of depth x 139 KiB per camera); the camera-thread side
 // (queue push, trigger ring pop, doorbells) is noexcept, lock-free and allocation-free.
 #pragma once
@@ -41,6 +49,14 @@ struct TriggerStamp {
   std::int64_t received_ns = 0;  // node CLOCK_REALTIME
   std::int64_t fire_ns = 0;      // node CLOCK_MONOTONIC instant to fire at; 0: at once
 };
+
+struct FireInstant {
+  std::int64_t mono_ns = 0;  // CLOCK_MONOTONIC to fire at; 0: at once
+  bool late = false;         // scheduled, arrived after its instant
+  bool unsynced = false;     // the instant lay further ahead than the lead: clocks apart
+};
+FireInstant fire_instant(std::int64_t fire_ns, std::int64_t sent_ns, std::int64_t now_rt,
+                         std::int64_t now_mono) noexcept;
 
 class NodeSender {
  public:
@@ -72,8 +88,8 @@ class NodeSender {
   std::uint64_t write_errors() const noexcept { return write_errors_.get(); }
   std::uint64_t triggers_received() const noexcept { return triggers_in_.get(); }
   std::uint64_t triggers_dropped() const noexcept { return triggers_dropped_.get(); }
-  // Triggers whose instant lay beyond 2 x kMaxTriggerLeadUs ahead (clocks apart): fired
-  // on arrival.
+  // Triggers whose instant lay further ahead than their lead (clocks apart): fired one
+  // lead after the arrival.
   std::uint64_t triggers_unsynced() const noexcept { return triggers_unsynced_.get(); }
   // Scheduled triggers that arrived after their instant (the lead was shorter than the
   // trigger's way): fired on arrival.

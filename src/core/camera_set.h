@@ -29,8 +29,7 @@ inline constexpr int kMaxCameras = 32;
 // Cameras of one camera node (`mocap node`: capture + detection on one PC).
 inline constexpr int kMaxNodeCameras = 8;
 // The longest lead a central trigger to camera nodes may be posted with ahead of its
-// instant (node.trigger_lead_us); a node takes an instant further ahead than twice this
-// for a clock disagreement.
+// instant (node.trigger_lead_us), and the longest a node waits for a trigger's instant.
 inline constexpr std::int64_t kMaxTriggerLeadUs = 100'000;
 
 // A set of cameras: bit c for camera c (c < kMaxCameras).

@@ -4,7 +4,8 @@
 // not started). The detection workers of the `trigger: central` cameras play every
 // camera's frame of every trigger, in trigger order, the replay's frame the trigger names
 // (a skipped number is seeked over), with the same blob lists whatever the worker count;
-// node.detect_threads' default and its bounds; a scheduled trigger fires at its instant.
+// node.detect_threads' default and its bounds; a scheduled trigger fires at its instant,
+// which the node takes on its own clock but never more than the lead after the arrival.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -168,6 +169,37 @@ TEST_F(NodeRunnerTest, AScheduledTriggerFiresAtItsInstantInOrder) {
       }
     }
   }
+}
+
+TEST(NodeFireInstant, TheInstantOnThisClockNeverMoreThanTheLeadAfterTheArrival) {
+  constexpr std::int64_t kMs = 1'000'000;
+  const std::int64_t sent = 5'000 * kMs, mono = 77 * kMs;
+  // Not scheduled: at once, nothing counted.
+  FireInstant f = fire_instant(0, sent, sent + kMs, mono);
+  EXPECT_EQ(f.mono_ns, 0);
+  EXPECT_FALSE(f.late || f.unsynced);
+  // Synchronised clocks, 1 ms lead, 0.1 ms on the way: 0.9 ms from now.
+  f = fire_instant(sent + kMs, sent, sent + kMs / 10, mono);
+  EXPECT_EQ(f.mono_ns, mono + 9 * kMs / 10);
+  EXPECT_FALSE(f.late || f.unsynced);
+  // Arrived after its instant: at once, late.
+  f = fire_instant(sent + kMs, sent, sent + 2 * kMs, mono);
+  EXPECT_EQ(f.mono_ns, 0);
+  EXPECT_TRUE(f.late);
+  // This clock 50 ms behind the central's: the instant seems 51 ms ahead; fired one lead
+  // after the arrival instead, unsynced.
+  f = fire_instant(sent + kMs, sent, sent - 50 * kMs, mono);
+  EXPECT_EQ(f.mono_ns, mono + kMs);
+  EXPECT_TRUE(f.unsynced);
+  EXPECT_FALSE(f.late);
+  // A hostile lead of an hour waits at most kMaxTriggerLeadUs; one before its own send
+  // time fires at once.
+  f = fire_instant(sent + 3'600'000 * kMs, sent, sent, mono);
+  EXPECT_EQ(f.mono_ns, mono + kMaxTriggerLeadUs * 1000);
+  EXPECT_TRUE(f.unsynced);
+  f = fire_instant(sent - kMs, sent, sent - 2 * kMs, mono);
+  EXPECT_EQ(f.mono_ns, mono);
+  EXPECT_TRUE(f.unsynced);
 }
 
 TEST(NodeRunnerWorkers, DefaultIsTheCentralCamerasUpToTheOnlineCpus) {
