@@ -110,8 +110,8 @@ void CaptureStage::run() noexcept {
     at_instant = at_instant || (software[ci] && !ahead[ci]);
     lead_ns = std::max(lead_ns, lead);
   }
-  // At most half a period ahead: the previous trigger's frames come first (the
-  // configuration refuses more; this bounds what a camera asks).
+  // At most half a period ahead, so the previous trigger's frames come first (the
+  // configuration bounds node.trigger_lead_us at kMaxTriggerLeadUs, not by the period).
   lead_ns = std::min(lead_ns, period_ns / 2);
   setup_clock_checks(triggered_mode, period_ns);
   std::int64_t next_trigger_ns = monotonic_ns() + lead_ns;  // the first one ahead too

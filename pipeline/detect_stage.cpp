@@ -59,19 +59,17 @@ void DetectStage::run() noexcept {
       counters_.skipped.add();
       f = newer;
     }
-    (void)fill_slot(f);
+    pass(f);
     returned_.try_push(f);  // the image is no longer needed
   }
   context_.loop_end(id);
 }
 
-void DetectStage::pass(const hal::Frame& f) noexcept { (void)fill_slot(f); }
-
-bool DetectStage::fill_slot(const hal::Frame& f) noexcept {
+void DetectStage::pass(const hal::Frame& f) noexcept {
   rt::SlotHandle h;
   if (!out_.acquire(h)) {  // identify holds every slot (stalled): drop
     counters_.no_slot.add();
-    return false;
+    return;
   }
   const std::int64_t t0 = monotonic_ns();
   BlobSlot& slot = out_[h];
@@ -97,7 +95,6 @@ bool DetectStage::fill_slot(const hal::Frame& f) noexcept {
   const std::int64_t t1 = monotonic_ns();
   work_.record(t1 - t0);
   latency_.record(t1 - origin_ns);
-  return true;
 }
 
 void DetectStage::report(rt::CounterReport& out) const {

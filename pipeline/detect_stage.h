@@ -48,6 +48,8 @@ class DetectStage {
   // The camera delivers blobs (no detection): no thread; the capture thread calls pass()
   // for each frame and releases the frame itself afterwards.
   bool passes_through() const noexcept { return passes_through_; }
+  // The frame's blobs (detected, or passed on) into a blob slot for identify; dropped and
+  // counted (detect#_no_slot) when identify holds every slot. run() calls it too.
   void pass(const hal::Frame& f) noexcept;
 
   // The capture thread's ends: push frames in, take frames back.
@@ -67,9 +69,6 @@ class DetectStage {
   DetectStage(int camera, std::uint32_t input_capacity, std::uint32_t return_capacity,
               StageContext& context, FrameProcessor& processor, rt::SlotPool<BlobSlot>& out,
               bool passes_through);
-  // The frame's blobs (detected, or passed on) into a blob slot for identify; false when
-  // identify holds every slot (counted: dropped).
-  bool fill_slot(const hal::Frame& f) noexcept;
 
   const int camera_;
   const bool passes_through_;

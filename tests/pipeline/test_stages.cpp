@@ -113,17 +113,34 @@ TEST(StageContext, LedgerOnlyGrowsAndKeepsTheFirstSequence) {
   EXPECT_FALSE(context.stopping());
 }
 
-// Camera 0 of the simulated rig with a trigger lead: records each trigger_at() (the call
-// time and the instant; the capture thread writes, the test reads after stop()) and
-// fires the simulated trigger at once (what is checked is the capture stage's timing).
-class LeadCamera final : public hal::Camera {
+// Forwards every call to a simulated camera; the test cameras below change a few.
+class WrappedCamera : public hal::Camera {
  public:
-  LeadCamera(hal::Camera& inner, std::int64_t lead_ns) : inner_(inner), lead_ns_(lead_ns) {}
+  explicit WrappedCamera(hal::Camera& inner) : inner_(inner) {}
   const std::string& name() const noexcept override { return inner_.name(); }
   hal::CameraState state() const noexcept override { return inner_.state(); }
   Expected<void> configure(const hal::CameraConfig& c) override { return inner_.configure(c); }
   Expected<void> start() override { return inner_.start(); }
   void stop() noexcept override { inner_.stop(); }
+  hal::CameraStatus trigger() noexcept override { return inner_.trigger(); }
+  hal::CameraStatus dequeue(hal::Frame& f, int timeout_ms) noexcept override {
+    return inner_.dequeue(f, timeout_ms);
+  }
+  hal::CameraStatus release(const hal::Frame& f) noexcept override { return inner_.release(f); }
+  const hal::CameraConfig& config() const noexcept override { return inner_.config(); }
+  const std::string& notice() const noexcept override { return inner_.notice(); }
+  const hal::CameraCounters& counters() const noexcept override { return inner_.counters(); }
+
+ protected:
+  hal::Camera& inner_;
+};
+
+// Camera 0 of the simulated rig with a trigger lead: records each trigger_at() (the call
+// time and the instant; the capture thread writes, the test reads after stop()) and
+// fires the simulated trigger at once (what is checked is the capture stage's timing).
+class LeadCamera final : public WrappedCamera {
+ public:
+  LeadCamera(hal::Camera& inner, std::int64_t lead_ns) : WrappedCamera(inner), lead_ns_(lead_ns) {}
   hal::CameraStatus trigger() noexcept override {
     plain.fetch_add(1, std::memory_order_relaxed);
     return inner_.trigger();
@@ -137,13 +154,6 @@ class LeadCamera final : public hal::Camera {
     }
     return inner_.trigger();
   }
-  hal::CameraStatus dequeue(hal::Frame& f, int timeout_ms) noexcept override {
-    return inner_.dequeue(f, timeout_ms);
-  }
-  hal::CameraStatus release(const hal::Frame& f) noexcept override { return inner_.release(f); }
-  const hal::CameraConfig& config() const noexcept override { return inner_.config(); }
-  const std::string& notice() const noexcept override { return inner_.notice(); }
-  const hal::CameraCounters& counters() const noexcept override { return inner_.counters(); }
 
   struct Call {
     std::int64_t at_call_ns = 0, instant_ns = 0;
@@ -153,7 +163,6 @@ class LeadCamera final : public hal::Camera {
   std::atomic<int> plain{0};
 
  private:
-  hal::Camera& inner_;
   std::int64_t lead_ns_;
 };
 
@@ -199,21 +208,15 @@ TEST(CaptureStage, ACameraWithALeadIsTriggeredAheadOfEachInstant) {
 
 // A simulated camera whose frames also carry their blobs, detected in dequeue() with the
 // tracker's own detector configuration (as a camera node's frames arrive detected).
-class BlobCamera final : public hal::Camera {
+class BlobCamera final : public WrappedCamera {
  public:
-  explicit BlobCamera(hal::Camera& inner) : inner_(inner) {
+  explicit BlobCamera(hal::Camera& inner) : WrappedCamera(inner) {
     const hal::CameraConfig& c = inner.config();
     auto d = detect::BlobDetector::create(TrackerConfig{}.detect, c.width, c.height);
     EXPECT_TRUE(d.ok());
     for (int b = 0; b < c.buffer_count; ++b) lists_.push_back(d->make_blob_list());
     detector_.emplace(std::move(d).value());
   }
-  const std::string& name() const noexcept override { return inner_.name(); }
-  hal::CameraState state() const noexcept override { return inner_.state(); }
-  Expected<void> configure(const hal::CameraConfig& c) override { return inner_.configure(c); }
-  Expected<void> start() override { return inner_.start(); }
-  void stop() noexcept override { inner_.stop(); }
-  hal::CameraStatus trigger() noexcept override { return inner_.trigger(); }
   bool delivers_blobs() const noexcept override { return true; }
   hal::CameraStatus dequeue(hal::Frame& f, int timeout_ms) noexcept override {
     const hal::CameraStatus s = inner_.dequeue(f, timeout_ms);
@@ -225,13 +228,8 @@ class BlobCamera final : public hal::Camera {
     }
     return s;
   }
-  hal::CameraStatus release(const hal::Frame& f) noexcept override { return inner_.release(f); }
-  const hal::CameraConfig& config() const noexcept override { return inner_.config(); }
-  const std::string& notice() const noexcept override { return inner_.notice(); }
-  const hal::CameraCounters& counters() const noexcept override { return inner_.counters(); }
 
  private:
-  hal::Camera& inner_;
   std::optional<detect::BlobDetector> detector_;
   std::vector<detect::BlobList> lists_;
 };
