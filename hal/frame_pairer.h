@@ -167,11 +167,13 @@ class FramePairer {
     return paired;
   }
 
-  // Hands every pending frame to on_drop (at stop), without counting it.
+  // Hands every pending frame to on_drop: at stop, uncounted; at the input's end
+  // (unmatched = true), counted as unmatched (no partner will ever come).
   template <class OnDrop>
-  void flush(OnDrop&& on_drop) noexcept {
+  void flush(OnDrop&& on_drop, bool unmatched = false) noexcept {
     for (int c = 0; c < config_.cameras; ++c) {
       while (pending_[c].count > 0) {
+        if (unmatched) counters_.unmatched[c].add();
         on_drop(c, pending_[c].at(0));
         pending_[c].erase(0);
       }

@@ -14,6 +14,8 @@ namespace {
 // How often a consumer that caught up with the loader looks again (only when the
 // loader is behind: a replay faster than the disk).
 constexpr std::int64_t kReadAheadPollNs = 50'000;
+// The loader's sleep's safety net (a ring wakes it at once).
+constexpr std::int64_t kLoaderWaitNs = 100'000'000;
 
 }  // namespace
 
@@ -65,10 +67,9 @@ ReplayReadAhead::~ReplayReadAhead() {
 }
 
 void ReplayReadAhead::wake() noexcept {
-  // release: what the waker did before (a buffer pushed, stop_) is visible to the
-  // loader that sees the new value.
-  wake_.fetch_add(1, std::memory_order_release);
-  wake_.notify_one();
+  // The ring (seq_cst) makes what the waker did before (a buffer pushed, stop_) visible
+  // to the loader whose snapshot sees it.
+  wake_.ring();
 }
 
 void ReplayReadAhead::give_back(std::uint32_t buffer) noexcept {
@@ -96,9 +97,8 @@ void ReplayReadAhead::run() noexcept {
   std::uint32_t buffer = 0;
   bool have_buffer = false;
   while (!stop_.load(std::memory_order_relaxed)) {
-    // acquire: pairs with wake()'s release; read before looking, so a wake between the
-    // look and the wait is not lost (the wait returns at once on a changed value).
-    const std::uint32_t seen = wake_.load(std::memory_order_acquire);
+    // Taken before looking, so a ring between the look and the wait is not lost.
+    const std::uint32_t seen = wake_.snapshot();
     next = std::max<std::size_t>(next, skip_to_.load(std::memory_order_relaxed));
     if (next < frames.size() && (have_buffer || free_.try_pop(buffer))) {
       have_buffer = true;
@@ -119,7 +119,7 @@ void ReplayReadAhead::run() noexcept {
       ++next;
       continue;
     }
-    wake_.wait(seen, std::memory_order_acquire);
+    wake_.wait(seen, kLoaderWaitNs);
   }
 }
 

@@ -9,10 +9,10 @@
 //   by the consumer between next() and give_back(). The rings' release/acquire order the
 //   image bytes: the loader writes them before pushing, the consumer reads after popping;
 //   the consumer has finished with a buffer before give_back() pushes it.
-//   The loader sleeps on a 32-bit atomic (futex) when it has no free buffer or nothing
-//   left to load; give_back() and the destructor wake it. It runs with the default
-//   scheduling policy: the pipeline's SCHED_FIFO stages preempt it, so it reads while
-//   they are idle.
+//   The loader sleeps on a doorbell (rt/doorbell.h: a futex with a timeout) when it has no
+//   free buffer or nothing left to load; give_back(), skip_to() and the destructor ring it. It runs
+//   with the default scheduling policy: the pipeline's SCHED_FIFO stages preempt it, so it reads
+//   while they are idle.
 // skip_to(index) makes the loader go on at frame `index` (never back) without reading
 // the frames before it; entries it loaded before are still handed out (the consumer
 // gives those back unused).
@@ -31,6 +31,7 @@
 #include "core/expected.h"
 #include "core/image.h"
 #include "formats/recording.h"
+#include "rt/doorbell.h"
 #include "rt/spsc_ring.h"
 
 namespace mocap::hal {
@@ -85,7 +86,7 @@ class ReplayReadAhead {
   PixelFormat format_;
   rt::SpscRing<std::uint32_t> free_;  // capture thread -> loader
   rt::SpscRing<Loaded> loaded_;       // loader -> capture thread
-  std::atomic<std::uint32_t> wake_{0};
+  rt::Doorbell wake_;
   std::atomic<std::uint32_t> skip_to_{0};  // consumer -> loader: the lowest frame to load
   std::atomic<bool> stop_{false};
   std::thread thread_;

@@ -51,16 +51,43 @@ void CaptureStage::setup_clock_checks(bool triggered_mode, std::int64_t period_n
   }
 }
 
-void CaptureStage::finish_triggering() noexcept {
-  if (context_.triggering_done()) return;
-  end_sequence_.store(std::min(delivered_end_, ended_end_), std::memory_order_relaxed);
-  context_.set_triggering_done();  // release: publishes end_sequence_ too
+void CaptureStage::finish_capture() noexcept {
+  // release (in set_capture_done): publishes every frame handed on before.
+  context_.set_capture_done(std::min(delivered_end_, ended_end_));
+}
+
+bool CaptureStage::tail_pending(std::uint64_t fired) const noexcept {
+  const std::uint64_t end = std::min(delivered_end_, ended_end_);
+  for (int c = 0; c < camera_count_; ++c) {
+    const auto ci = static_cast<std::size_t>(c);
+    // Done: its stream ended, it delivered the last set's sequence (one numbering for
+    // every camera), or one frame per trigger (cameras with numberings of their own).
+    const bool done =
+        ended_[ci] || camera_end_[ci] >= end || (fired != 0 && dequeued_[ci] >= fired);
+    if (!done) return true;
+  }
+  return false;
+}
+
+void CaptureStage::take_tail(std::uint64_t fired, std::int64_t last_trigger_ns,
+                             bool& end_of_stream) noexcept {
+  rt::Doorbell& bell = context_.bell(StageId::kCapture);
+  const std::int64_t deadline = monotonic_ns() + kLateFrameNs;
+  while (!context_.stopping() && tail_pending(fired) && monotonic_ns() < deadline) {
+    const std::uint32_t seen = bell.snapshot();
+    std::uint64_t last = 0;
+    for (int c = 0; c < camera_count_; ++c)
+      (void)poll_camera(c, 0, fired != 0, last_trigger_ns, last, end_of_stream, false);
+    if (!tail_pending(fired)) break;
+    bell.wait(seen, kLockstepPollNs);
+    release_returned();
+  }
 }
 
 void CaptureStage::wait_retired(std::uint64_t sequence, std::int64_t last_trigger_ns,
                                 bool& end_of_stream) noexcept {
-  Doorbell& bell = context_.bell(StageId::kCapture);
-  const std::int64_t deadline = monotonic_ns() + kLockstepTimeoutNs;
+  rt::Doorbell& bell = context_.bell(StageId::kCapture);
+  const std::int64_t deadline = monotonic_ns() + kLateFrameNs;
   while (!context_.stopping() && context_.retired_plus_one() <= sequence &&
          monotonic_ns() < deadline) {
     const std::uint32_t seen = bell.snapshot();
@@ -77,8 +104,8 @@ void CaptureStage::wait_retired(std::uint64_t sequence, std::int64_t last_trigge
 
 bool CaptureStage::wait_first_frame(std::int64_t last_trigger_ns, std::uint64_t& last_sequence,
                                     bool& end_of_stream) noexcept {
-  Doorbell& bell = context_.bell(StageId::kCapture);
-  const std::int64_t deadline = monotonic_ns() + kLockstepTimeoutNs;
+  rt::Doorbell& bell = context_.bell(StageId::kCapture);
+  const std::int64_t deadline = monotonic_ns() + kLateFrameNs;
   while (!context_.stopping() && !end_of_stream && monotonic_ns() < deadline) {
     const std::uint32_t seen = bell.snapshot();
     bool pushed = false;
@@ -117,15 +144,22 @@ void CaptureStage::run() noexcept {
   std::int64_t next_trigger_ns = monotonic_ns() + lead_ns;  // the first one ahead too
   std::int64_t last_trigger_ns = 0;  // host time of the last software trigger
   bool end_of_stream = false;        // a camera has no more frames (replay)
+  std::uint64_t fired = 0;           // triggers of this run
+  dequeued_ = {};
+  ended_ = {};
   while (!context_.stopping()) {
     release_returned();
-    if (triggered_mode) {
-      if (end_of_stream || (o.max_frames != 0 && k.triggered.get() >= o.max_frames)) {
-        finish_triggering();
-        Doorbell& bell = context_.bell(StageId::kCapture);
-        bell.wait(bell.snapshot(), kIdleWaitNs);
-        continue;
+    if (end_of_stream ||
+        (triggered_mode && o.max_frames != 0 && k.triggered.get() >= o.max_frames)) {
+      if (!context_.capture_done()) {
+        take_tail(triggered_mode ? fired : 0, last_trigger_ns, end_of_stream);
+        finish_capture();
       }
+      rt::Doorbell& bell = context_.bell(StageId::kCapture);
+      bell.wait(bell.snapshot(), kIdleWaitNs);
+      continue;
+    }
+    if (triggered_mode) {
       // Both pacings: at most trigger_rate_hz (lockstep may trigger later, never earlier).
       // The cameras with a lead are triggered that long before the instant.
       hal::sleep_until_ns(next_trigger_ns - lead_ns);
@@ -155,6 +189,7 @@ void CaptureStage::run() noexcept {
       }
       last_trigger_ns = instant;
       k.triggered.add();
+      ++fired;
     }
     // Wait for each camera's frame at most dequeue_timeout_ms and never past the next
     // trigger (a stalled camera must not delay the others or the trigger), then drain
@@ -203,7 +238,7 @@ bool CaptureStage::poll_camera(int c, int timeout_ms, bool triggered_mode,
       // No set can complete from this camera's last frame on (cameras of different
       // lengths: a camera node whose replay restarted).
       ended_end_ = std::min(ended_end_, camera_end_[ci]);
-      if (!triggered_mode) finish_triggering();
+      ended_[ci] = true;
       end_of_stream = true;
       break;
     }
@@ -212,6 +247,7 @@ bool CaptureStage::poll_camera(int c, int timeout_ms, bool triggered_mode,
       break;
     }
     on_frame_received(c, f, last_trigger_ns);
+    ++dequeued_[ci];
     const PipelineOptions& o = context_.options();
     if (o.tap != nullptr) o.tap->on_frame(c, f);
     if (!triggered_mode && c == 0) k.triggered.add();
@@ -222,6 +258,7 @@ bool CaptureStage::poll_camera(int c, int timeout_ms, bool triggered_mode,
       if (cam.release(f) != hal::CameraStatus::kOk) k.release_errors.add();
     } else if (detect_[ci]->input().try_push(f)) {
       pushed = true;
+      context_.note_handed_to_detect(c);
       context_.bell(StageId::detect(c)).ring();
     } else {  // the detector holds every slot (stalled): drop this frame
       k.ring_full[ci].add();

@@ -9,11 +9,13 @@
 // a camera node's, is handed on here through DetectStage::pass) and releases the buffers the
 // detect stages give back. It alone calls the cameras' release(), so every camera buffer
 // has one owner thread. A camera's end of stream (a replayed recording's last frame was
-// delivered) ends the triggering, as max_frames does. It owns no ring: each detect stage owns its
-// input and return rings; the capture holds their producer and consumer ends. run() is the hot
-// path: noexcept, allocation-free, lock-free, no logging; the only syscalls are the cameras'
-// trigger/dequeue/release and the trigger clock's sleep. Lockstep pacing waits (each wait
-// bounded by 1 s) for the last trigger's first frame and then for it to be retired, polling
+// delivered) ends the triggering, as max_frames does; the capture then takes the last
+// triggers' late frames (the tail, bounded by 1 s) and declares its end
+// (StageContext::set_capture_done: the frame ledger that ends the run). It owns no ring: each
+// detect stage owns its input and return rings; the capture holds their producer and consumer ends.
+// run() is the hot path: noexcept, allocation-free, lock-free, no logging; the only syscalls are
+// the cameras' trigger/dequeue/release and the trigger clock's sleep. Lockstep pacing waits (each
+// wait bounded by 1 s) for the last trigger's first frame and then for it to be retired, polling
 // the cameras every millisecond, so a frame that came after its camera's dequeue timed out
 // (a camera node's round trip) still completes its set and no trigger runs ahead of it.
 #pragma once
@@ -43,14 +45,6 @@ class CaptureStage {
 
   // Any thread.
   std::uint64_t triggered() const noexcept { return counters_.triggered.get(); }
-  // Once the triggering is done (StageContext::triggering_done()): the highest sequence
-  // the cameras delivered + 1 (at most the end of the first camera whose stream ended:
-  // later sequences can never form a set), the sequence the pipeline must retire to be finished
-  // (sequences are the cameras' own: a replay's start at its recording's first frame).
-  std::uint64_t end_sequence() const noexcept {
-    // relaxed: read after StageContext::triggering_done() (acquire), which it precedes.
-    return end_sequence_.load(std::memory_order_relaxed);
-  }
   // Time since camera c's last frame (since the start before its first one).
   std::int64_t camera_silent_ns(int camera, std::int64_t now_ns) const noexcept {
     // relaxed: a single writer (this stage); readers only want a recent, untorn time.
@@ -83,7 +77,8 @@ class CaptureStage {
   bool poll_camera(int c, int timeout_ms, bool triggered_mode, std::int64_t last_trigger_ns,
                    std::uint64_t& last_sequence, bool& end_of_stream, bool count_timeouts) noexcept;
 
-  static constexpr std::int64_t kLockstepTimeoutNs = 1'000'000'000;
+  // A frame later than this after its trigger is lost (lockstep's waits, the tail).
+  static constexpr std::int64_t kLateFrameNs = 1'000'000'000;
   static constexpr std::int64_t kLockstepPollNs = 1'000'000;  // cameras polled while waiting
 
   StageContext& context_;
@@ -93,12 +88,19 @@ class CaptureStage {
   const std::int64_t start_ns_;
   std::array<TimestampCheck, kMaxCameras> clock_checks_{};  // this thread (set in run())
   std::array<std::atomic<std::int64_t>, kMaxCameras> last_frame_ns_{};  // this thread writes
-  void finish_triggering() noexcept;
+  // The capture's end (StageContext::set_capture_done): no frame is handed on after it.
+  void finish_capture() noexcept;
+  // The last triggers' frames that came after their dequeue pass (a slow camera): taken
+  // until every camera delivered its last one or ended, for at most kLateFrameNs, so that
+  // the last sets complete. fired: the triggers of this run (0: free-running cameras).
+  void take_tail(std::uint64_t fired, std::int64_t last_trigger_ns, bool& end_of_stream) noexcept;
+  bool tail_pending(std::uint64_t fired) const noexcept;
   std::uint64_t delivered_end_ = 0;  // highest sequence dequeued + 1 (this thread)
   std::array<std::uint64_t, kMaxCameras> camera_end_{};  // the same per camera (this thread)
   // The lowest camera_end_ of the cameras that reached their end of stream (this thread).
   std::uint64_t ended_end_ = ~std::uint64_t{0};
-  std::atomic<std::uint64_t> end_sequence_{0};  // delivered_end_ when the triggering ended
+  std::array<std::uint64_t, kMaxCameras> dequeued_{};  // frames per camera, this run (this thread)
+  std::array<bool, kMaxCameras> ended_{};  // the camera's stream ended, this run (this thread)
 
   struct alignas(64) Counters {
     rt::CounterGroup group;

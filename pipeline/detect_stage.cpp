@@ -42,7 +42,7 @@ DetectStage::DetectStage(int camera, std::uint32_t input_capacity, std::uint32_t
 void DetectStage::run() noexcept {
   const StageId id = StageId::detect(camera_);
   context_.loop_start(id);
-  Doorbell& bell = context_.bell(id);
+  rt::Doorbell& bell = context_.bell(id);
   const PipelineOptions& options = context_.options();
   while (!context_.stopping()) {
     const std::uint32_t seen = bell.snapshot();
@@ -57,10 +57,12 @@ void DetectStage::run() noexcept {
     while (!options.fresh(hal::latency_origin_ns(f), now) && input_.try_pop(newer)) {
       returned_.try_push(f);  // cannot fail: holds every camera buffer
       counters_.skipped.add();
+      context_.note_detected(camera_);
       f = newer;
     }
     pass(f);
-    returned_.try_push(f);  // the image is no longer needed
+    returned_.try_push(f);            // the image is no longer needed
+    context_.note_detected(camera_);  // after pass(): its blob slot is in identify's pool
   }
   context_.loop_end(id);
 }

@@ -2,6 +2,7 @@
 #include "pipeline/identify_stage.h"
 
 #include <algorithm>
+#include <limits>
 #include <string>
 #include <utility>
 
@@ -71,7 +72,7 @@ int IdentifyStage::first_present(const hal::FramePair& set) const noexcept {
 
 void IdentifyStage::run() noexcept {
   context_.loop_start(StageId::kIdentify);
-  Doorbell& bell = context_.bell(StageId::kIdentify);
+  rt::Doorbell& bell = context_.bell(StageId::kIdentify);
   auto on_drop = [this](int c, const hal::PairEntry& e) {
     rt::SlotPool<BlobSlot>& pool = *inputs_[static_cast<std::size_t>(c)];
     const std::uint64_t sequence = pool[e.handle].sequence;
@@ -96,14 +97,20 @@ void IdentifyStage::run() noexcept {
     set = p;
     have_set = true;
   };
+  bool done = false;  // this run's input ended and was settled (see settle())
   while (!context_.stopping()) {
     const std::uint32_t seen = bell.snapshot();
     const std::int64_t now = monotonic_ns();
+    // The capture's end, and every frame it handed on came out of the detect stages
+    // (acquire loads: their blob slots are in the pools now): the pops below are the last.
+    const bool last_pops = !done && context_.capture_done() && context_.detect_drained(cameras_);
     hal::FramePair p;
+    bool popped = false;
     for (int c = 0; c < cameras_; ++c) {
       rt::SlotPool<BlobSlot>& pool = *inputs_[static_cast<std::size_t>(c)];
       rt::SlotHandle h;
       while (pool.pop(h)) {
+        popped = true;
         const std::int64_t key =
             by_time ? pool[h].capture_ns : static_cast<std::int64_t>(pool[h].sequence);
         if (pairer_.push(c, hal::PairEntry{key, h}, p, on_drop, now)) take(p);
@@ -112,6 +119,15 @@ void IdentifyStage::run() noexcept {
     // Silent cameras (camera nodes, PipelineOptions::silent_after_ns): the sets that
     // waited for them long enough complete without them.
     while (pairer_.expire(now, p)) take(p);
+    if (!have_set && last_pops && !popped) {
+      // No frame will come: the sets that may complete without silent cameras do so
+      // now, as if their bounds had passed; the rest are settled.
+      while (pairer_.expire(std::numeric_limits<std::int64_t>::max() / 2, p)) take(p);
+      if (!have_set) {
+        settle();
+        done = true;
+      }
+    }
     if (!have_set) {
       const std::int64_t until_silence = pairer_.next_silence_ns() - now;
       bell.wait(seen, std::clamp<std::int64_t>(until_silence, 1, kIdleWaitNs));
@@ -160,6 +176,7 @@ void IdentifyStage::process(const hal::FramePair& set) noexcept {
     if ((out_[m].frame.joints.flags & client::kFlagAllBodiesFound) == 0)
       counters_.without_result.add();
     out_.publish(m);
+    context_.note_handed_to_publish();
     context_.bell(StageId::kPublish).ring();
   } else {  // publish holds every slot (stalled sink)
     counters_.no_slot.add();
@@ -168,6 +185,20 @@ void IdentifyStage::process(const hal::FramePair& set) noexcept {
   const std::int64_t t1 = monotonic_ns();
   work_.record(t1 - t0);
   latency_.record(t1 - origin_ns);
+}
+
+void IdentifyStage::settle() noexcept {
+  // The sets still pending can never complete: their frames are dropped as the pairer
+  // drops a frame another camera has passed (unmatched), and the sequences from the last
+  // set taken to the capture's last one are counted as never paired.
+  pairer_.flush(
+      [this](int c, const hal::PairEntry& e) {
+        inputs_[static_cast<std::size_t>(c)]->release(e.handle);
+      },
+      true);
+  const std::uint64_t end = context_.end_sequence();
+  if (end > 0) count_unpaired(end);
+  context_.set_identify_done();
 }
 
 void IdentifyStage::drain() noexcept {

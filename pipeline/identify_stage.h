@@ -78,6 +78,9 @@ class IdentifyStage {
     return (*inputs_[static_cast<std::size_t>(c)])[set.cam[c].handle].origin_ns;
   }
   void process(const hal::FramePair& set) noexcept;
+  // The run's input ended (StageContext's frame ledger): the pending sets are dropped and
+  // counted, and identify declares its end.
+  void settle() noexcept;
 
   StageContext& context_;
   FrameProcessor& processor_;

@@ -201,8 +201,8 @@ void Pipeline::stop() noexcept {
 }
 
 bool Pipeline::finished() const noexcept {
-  if (!capture_ || !context_.triggering_done()) return false;  // acquire: see there
-  return context_.retired_plus_one() >= capture_->end_sequence() || context_.stopping();
+  if (!capture_ || !context_.capture_done()) return false;  // acquire: see there
+  return context_.drained() || context_.stopping();
 }
 
 }  // namespace mocap::pipeline

@@ -23,7 +23,7 @@ PublishStage::PublishStage(StageContext& context, std::vector<publish::OutputSin
 
 void PublishStage::run() noexcept {
   context_.loop_start(StageId::kPublish);
-  Doorbell& bell = context_.bell(StageId::kPublish);
+  rt::Doorbell& bell = context_.bell(StageId::kPublish);
   std::uint64_t skipped_seen = 0;
   std::int64_t prev_publish_ns = 0;
   const PipelineOptions& options = context_.options();
@@ -36,7 +36,9 @@ void PublishStage::run() noexcept {
       bell.wait(seen, kIdleWaitNs);
       continue;
     }
+    std::uint64_t done = 1;                  // this message, and the older ones it replaced
     if (input_.skipped() != skipped_seen) {  // older messages replaced by this one
+      done += input_.skipped() - skipped_seen;
       counters_.skipped.add(input_.skipped() - skipped_seen);
       skipped_seen = input_.skipped();
     }
@@ -67,6 +69,7 @@ void PublishStage::run() noexcept {
     last_publish_ns_.store(t0, std::memory_order_relaxed);
     published_.fetch_add(1, std::memory_order_release);
     context_.retire(sequence);
+    context_.note_published(done);
   }
   context_.loop_end(StageId::kPublish);
 }

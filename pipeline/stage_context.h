@@ -1,8 +1,8 @@
 // Design: what the stage threads of the live pipeline share, and the buffers they pass.
-//   - StageContext: the options, the stop flag, one Doorbell per thread and the sequence
-//     ledger (the first sequence captured, the highest one retired, "triggering done"),
-//     which lockstep pacing and Pipeline::finished() read. It is the only state more
-//     than one stage writes (retire(): identify and publish), and holds only atomics.
+//   - StageContext: the options, the stop flag, one Doorbell per thread, the sequences
+//     (the first one captured, the highest one retired: lockstep pacing) and the frame
+//     ledger (how many frames each stage handed on: Pipeline::finished()). It is the only state
+//     more than one stage writes (retire(): identify and publish), and holds only atomics.
 //   - BlobSlot (detect c -> identify, one rt::SlotPool per camera) and MsgSlot
 //     (identify -> publish): preallocated at start(), passed by handle.
 // Every call is noexcept, lock-free and allocation-free; the memory orders are
@@ -15,10 +15,10 @@
 
 #include "core/clock.h"
 #include "detect/blob.h"
-#include "pipeline/doorbell.h"
 #include "pipeline/pipeline_options.h"
 #include "pipeline/publish/frame_result.h"
 #include "pipeline/stage_table.h"
+#include "rt/doorbell.h"
 
 namespace mocap::pipeline {
 
@@ -45,19 +45,25 @@ class StageContext {
   StageContext& operator=(const StageContext&) = delete;
 
   const PipelineOptions& options() const noexcept { return options_; }
-  Doorbell& bell(StageId id) noexcept { return bells_[index(id)]; }
+  rt::Doorbell& bell(StageId id) noexcept { return bells_[index(id)]; }
 
   // Before the threads start (no thread runs: relaxed).
   void reset() noexcept {
     stop_.store(false, std::memory_order_relaxed);
-    triggering_done_.store(false, std::memory_order_relaxed);
+    capture_done_.store(false, std::memory_order_relaxed);
+    identify_done_.store(false, std::memory_order_relaxed);
+    end_sequence_.store(0, std::memory_order_relaxed);
+    for (auto& n : to_detect_) n.store(0, std::memory_order_relaxed);
+    for (auto& n : detected_) n.store(0, std::memory_order_relaxed);
+    to_publish_.store(0, std::memory_order_relaxed);
+    published_.store(0, std::memory_order_relaxed);
     first_sequence_.store(0, std::memory_order_relaxed);
     retired_.store(0, std::memory_order_relaxed);
   }
   void request_stop() noexcept {
     // release: the stage threads' acquire loads see everything before the stop request.
     stop_.store(true, std::memory_order_release);
-    for (Doorbell& b : bells_) b.ring();
+    for (rt::Doorbell& b : bells_) b.ring();
   }
   bool stopping() const noexcept { return stop_.load(std::memory_order_acquire); }
 
@@ -97,20 +103,74 @@ class StageContext {
     return retired_.load(std::memory_order_acquire);  // pairs with retire()
   }
 
-  // Capture thread: no more triggers (max_frames reached, or a replay's end).
-  void set_triggering_done() noexcept {
-    // release: finished() (acquire) then sees every counter written before.
-    triggering_done_.store(true, std::memory_order_release);
+  // The frame ledger: how the run's end is known exactly. The capture counts the frames
+  // it hands to each detect stage and then declares its end (no frame after it); each
+  // detect stage counts the frames of its input it is done with (handed to identify,
+  // skipped or dropped); identify, once both counts agree for every camera, has received
+  // every frame there will be: it settles the sets still pending and declares its end with
+  // the count of messages it handed to publish; publish counts the messages it is done
+  // with. The run is drained when the last two agree.
+  void note_handed_to_detect(int camera) noexcept {  // capture thread
+    // relaxed: a single writer; read after capture_done() (acquire), which it precedes.
+    to_detect_[static_cast<std::size_t>(camera)].fetch_add(1, std::memory_order_relaxed);
   }
-  bool triggering_done() const noexcept {
-    return triggering_done_.load(std::memory_order_acquire);  // see set_triggering_done()
+  void note_detected(int camera) noexcept {  // detect stage `camera`
+    // release: identify's acquire load that sees the count then sees the blob slot.
+    detected_[static_cast<std::size_t>(camera)].fetch_add(1, std::memory_order_release);
+  }
+  // Capture thread: no frame is handed on from now (max_frames reached or a replay's end,
+  // and the tail taken). end_sequence: the highest sequence dequeued + 1.
+  void set_capture_done(std::uint64_t end_sequence) noexcept {
+    end_sequence_.store(end_sequence, std::memory_order_relaxed);  // published below
+    // release: a thread that sees capture_done() sees the ledger and end_sequence.
+    capture_done_.store(true, std::memory_order_release);
+  }
+  bool capture_done() const noexcept {
+    return capture_done_.load(std::memory_order_acquire);  // see set_capture_done()
+  }
+  std::uint64_t end_sequence() const noexcept {            // after capture_done()
+    return end_sequence_.load(std::memory_order_relaxed);  // see set_capture_done()
+  }
+  // Identify: every frame handed to the detect stages came out of them (capture_done()).
+  bool detect_drained(int cameras) const noexcept {
+    for (std::size_t c = 0; c < static_cast<std::size_t>(cameras); ++c) {
+      // acquire: pairs with note_detected(); relaxed: see note_handed_to_detect().
+      if (detected_[c].load(std::memory_order_acquire) !=
+          to_detect_[c].load(std::memory_order_relaxed))
+        return false;
+    }
+    return true;
+  }
+  void note_handed_to_publish() noexcept {  // identify
+    // relaxed: a single writer; read after identify_done() (acquire), which it precedes.
+    to_publish_.fetch_add(1, std::memory_order_relaxed);
+  }
+  void set_identify_done() noexcept {
+    identify_done_.store(true, std::memory_order_release);  // publishes to_publish_
+  }
+  void note_published(std::uint64_t messages) noexcept {  // publish: published or skipped
+    // release: drained() (acquire) sees what the sinks were given before.
+    published_.fetch_add(messages, std::memory_order_release);
+  }
+  // Every frame of the run went through, or was counted as lost.
+  bool drained() const noexcept {
+    // acquire: see set_identify_done() and note_published().
+    return identify_done_.load(std::memory_order_acquire) &&
+           published_.load(std::memory_order_acquire) ==
+               to_publish_.load(std::memory_order_relaxed);
   }
 
  private:
   const PipelineOptions& options_;
-  std::array<Doorbell, kMaxStages> bells_{};
+  std::array<rt::Doorbell, kMaxStages> bells_{};
   std::atomic<bool> stop_{false};
-  std::atomic<bool> triggering_done_{false};
+  std::atomic<bool> capture_done_{false};
+  std::atomic<bool> identify_done_{false};
+  std::atomic<std::uint64_t> end_sequence_{0};
+  std::array<std::atomic<std::uint64_t>, kMaxCameras> to_detect_{};
+  std::array<std::atomic<std::uint64_t>, kMaxCameras> detected_{};
+  std::atomic<std::uint64_t> to_publish_{0};
+  std::atomic<std::uint64_t> published_{0};
   std::atomic<std::uint64_t> first_sequence_{0};
   std::atomic<std::uint64_t> retired_{0};
 };

@@ -192,7 +192,7 @@ void NodeCamera::deliver_missing(hal::Frame& out) noexcept {
 hal::CameraStatus NodeCamera::dequeue(hal::Frame& out, int timeout_ms) noexcept {
   if (state_ != hal::CameraState::kStreaming) return hal::CameraStatus::kNotStreaming;
   const std::int64_t deadline = monotonic_ns() + static_cast<std::int64_t>(timeout_ms) * 1'000'000;
-  pipeline::Doorbell& bell = link_->bell();
+  rt::Doorbell& bell = link_->bell();
   for (;;) {
     const std::uint32_t seen = bell.snapshot();
     const bool have = take();

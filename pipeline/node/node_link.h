@@ -31,9 +31,9 @@
 
 #include "core/latency_histogram.h"
 #include "detect/blob.h"
-#include "pipeline/doorbell.h"
 #include "pipeline/node/node_dds.h"
 #include "rt/counter.h"
+#include "rt/doorbell.h"
 #include "rt/slot_pool.h"
 #include "rt/spsc_ring.h"
 #include "rt/thread.h"
@@ -70,7 +70,7 @@ class NodeLink {
   Expected<int> add_camera(const std::string& node, const std::string& camera, std::uint32_t slots,
                            int max_blobs);
   rt::SlotPool<Received>& inbox(int k) noexcept { return *inboxes_[static_cast<std::size_t>(k)]; }
-  pipeline::Doorbell& bell() noexcept { return bell_; }
+  rt::Doorbell& bell() noexcept { return bell_; }
 
   // Reference-counted by the cameras' start()/stop(): the first start starts the trigger
   // thread and the receiver and waits for the nodes; one line on nodes not seen (and on
@@ -138,7 +138,7 @@ class NodeLink {
   // within a message's round trip).
   std::atomic<std::int64_t> fire_rt_[256] = {};
   std::uint64_t next_trigger_ = 0;  // capture thread: the lowest number not yet posted
-  pipeline::Doorbell bell_, trigger_bell_;
+  rt::Doorbell bell_, trigger_bell_;
   std::atomic<bool> stop_{false};
   std::atomic<std::uint64_t> received_end_{0};  // the receiver writes
   int users_ = 0;                               // started cameras (setup thread)

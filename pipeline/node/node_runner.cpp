@@ -164,7 +164,7 @@ std::int64_t NodeRunner::take_triggers(int c) noexcept {
   }
 }
 
-void NodeRunner::wait_for(pipeline::Doorbell& bell, std::uint32_t seen,
+void NodeRunner::wait_for(rt::Doorbell& bell, std::uint32_t seen,
                           std::int64_t instant_ns) noexcept {
   // Asleep until kFireSpinNs before the instant (a trigger or the stop rings earlier),
   // then spinning, so the cameras fire at the instant and not a wake-up later.
@@ -265,7 +265,7 @@ bool NodeRunner::play(int c) noexcept {
 }
 
 void NodeRunner::work() noexcept {
-  pipeline::Doorbell& bell = sender_.trigger_bell();
+  rt::Doorbell& bell = sender_.trigger_bell();
   while (!stop_.load(std::memory_order_acquire)) {
     const std::uint32_t seen = bell.snapshot();
     // Every pending trigger whose instant came first (the exposures start together), then

@@ -126,7 +126,7 @@ class NodeRunner {
   // instant of the first one still ahead (kNoInstant: none).
   std::int64_t take_triggers(int c) noexcept;
   // A worker with nothing to play until instant_ns (CLOCK_MONOTONIC).
-  void wait_for(pipeline::Doorbell& bell, std::uint32_t seen, std::int64_t instant_ns) noexcept;
+  void wait_for(rt::Doorbell& bell, std::uint32_t seen, std::int64_t instant_ns) noexcept;
   void send(int c, const hal::Frame* f, std::uint16_t flags, const TriggerStamp& t) noexcept;
 
   std::vector<NodeCameraSpec> cams_;

@@ -34,9 +34,9 @@
 #include <vector>
 
 #include "core/camera_set.h"
-#include "pipeline/doorbell.h"
 #include "pipeline/node/node_dds.h"
 #include "rt/counter.h"
+#include "rt/doorbell.h"
 #include "rt/drop_oldest_queue.h"
 #include "rt/spsc_ring.h"
 #include "rt/thread.h"
@@ -79,7 +79,7 @@ class NodeSender {
   void wake() noexcept { bell_.ring(); }
   rt::SpscRing<TriggerStamp>& triggers(int c) noexcept { return *triggers_[idx(c)]; }
   // The detection workers' doorbell (node_runner.h): rung after each trigger's pushes.
-  pipeline::Doorbell& trigger_bell() noexcept { return trigger_bell_; }
+  rt::Doorbell& trigger_bell() noexcept { return trigger_bell_; }
   // Setup, before start(): how many workers a trigger wakes (the workers sharing the bell).
   void set_trigger_wakeups(int workers) noexcept { trigger_wakeups_ = workers; }
 
@@ -113,9 +113,9 @@ class NodeSender {
   std::vector<std::string> notes_;
   std::vector<std::unique_ptr<rt::DropOldestQueue<WireFrame>>> queues_;
   std::vector<std::unique_ptr<rt::SpscRing<TriggerStamp>>> triggers_;
-  pipeline::Doorbell trigger_bell_;
+  rt::Doorbell trigger_bell_;
   int trigger_wakeups_ = 1;
-  pipeline::Doorbell bell_;
+  rt::Doorbell bell_;
   std::atomic<bool> stop_{false};
   rt::RtThread send_thread_;
   rt::Counter sent_, write_errors_, triggers_in_, triggers_dropped_, triggers_unsynced_,

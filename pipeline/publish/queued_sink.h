@@ -28,9 +28,9 @@
 #include <thread>
 
 #include "core/expected.h"
-#include "pipeline/doorbell.h"
 #include "pipeline/publish/output_sink.h"
 #include "rt/counter.h"
+#include "rt/doorbell.h"
 #include "rt/drop_oldest_queue.h"
 
 namespace mocap::publish {
@@ -65,7 +65,7 @@ class QueuedSink : public OutputSink {
   void worker_loop() noexcept;
 
   std::unique_ptr<rt::DropOldestQueue<FrameResult>> queue_;
-  pipeline::Doorbell bell_;
+  rt::Doorbell bell_;
   std::atomic<bool> stop_{false};
   std::thread worker_;
   rt::Counter published_;  // worker: encode() returned

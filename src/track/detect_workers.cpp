@@ -11,10 +11,9 @@ ParallelDetect::ParallelDetect(FrameProcessor& proc) : proc_(proc) {
 }
 
 ParallelDetect::~ParallelDetect() {
-  // release: the worker that sees stop_ (acquire) stops; the increment wakes it.
+  // release: the worker that sees stop_ (acquire) stops; the ring wakes it.
   stop_.store(true, std::memory_order_release);
-  posted_.fetch_add(1, std::memory_order_release);
-  posted_.notify_one();
+  posted_.ring();
   worker_.join();
 }
 
@@ -34,7 +33,7 @@ void ParallelDetect::detect_claimed(std::uint32_t gen) noexcept {
     out_->camera_present[uc] = view != nullptr;
     if (view != nullptr) proc_.detect_camera(static_cast<int>(uc), *view, out_->blobs[uc]);
     // release: the caller's acquire load of completed_ sees this camera's blob list.
-    if (completed_.fetch_add(1, std::memory_order_release) + 1 == n) completed_.notify_one();
+    if (completed_.fetch_add(1, std::memory_order_release) + 1 == n) done_.ring();
     v = next_.load(std::memory_order_relaxed);
   }
 }
@@ -43,10 +42,16 @@ void ParallelDetect::run() noexcept {
   std::uint32_t seen = 0;
   std::uint32_t taken = 0;  // the last generation whose cameras this thread claimed
   for (;;) {
-    // acquire: pairs with the caller's (or the destructor's) release increment, so stop_
-    // is seen; the frame itself is published through next_ (detect_claimed).
-    posted_.wait(seen, std::memory_order_acquire);
-    seen = posted_.load(std::memory_order_acquire);
+    // Asleep until a ring after `seen` (a frame, warm() or the destructor) or the timeout;
+    // the frame itself is published through next_ (detect_claimed).
+    posted_.wait(seen, kWaitNs);
+    const std::uint32_t now = posted_.snapshot();
+    if (now == seen) {  // the timeout, not a ring: nothing to spin for
+      // acquire: pairs with the destructor's release store.
+      if (stop_.load(std::memory_order_acquire)) return;
+      continue;
+    }
+    seen = now;
     // Rung for a frame or by warm(): spin until a new generation is posted (bounded).
     const std::int64_t t0 = monotonic_ns();
     for (;;) {
@@ -58,7 +63,7 @@ void ParallelDetect::run() noexcept {
         taken = gen;
         // This frame's bell is consumed: sleep until the next warm() or frame, instead of
         // spinning through the frame's other stages.
-        seen = posted_.load(std::memory_order_relaxed);
+        seen = posted_.snapshot();
         detect_claimed(gen);
         break;
       }
@@ -68,11 +73,7 @@ void ParallelDetect::run() noexcept {
   }
 }
 
-void ParallelDetect::warm() noexcept {
-  // release: orders nothing of the frame (next_ publishes it); the increment is the bell.
-  posted_.fetch_add(1, std::memory_order_release);
-  posted_.notify_one();
-}
+void ParallelDetect::warm() noexcept { posted_.ring(); }
 
 void ParallelDetect::detect(std::span<const ImageView* const> views, FrameOutput& out) noexcept {
   const std::int64_t t0 = monotonic_ns();
@@ -83,9 +84,8 @@ void ParallelDetect::detect(std::span<const ImageView* const> views, FrameOutput
   completed_.store(0, std::memory_order_relaxed);
   const std::uint32_t gen = ++generation_;
   // The bell before the frame: a worker that sees the generation (acquire) also sees the
-  // bell, so it does not wake again for this frame. release: pairs with the worker's wait.
-  posted_.fetch_add(1, std::memory_order_release);
-  posted_.notify_one();
+  // ring (seq_cst), so it does not wake again for this frame.
+  posted_.ring();
   // release: publishes views_, out_ and the reset count with the generation's counter.
   next_.store(static_cast<std::uint64_t>(gen) << 32, std::memory_order_release);
   detect_claimed(gen);
@@ -97,8 +97,12 @@ void ParallelDetect::detect(std::span<const ImageView* const> views, FrameOutput
     rt::cpu_relax();
     k = completed_.load(std::memory_order_acquire);
   }
-  for (; k != n; k = completed_.load(std::memory_order_acquire))
-    completed_.wait(k, std::memory_order_acquire);
+  while (k != n) {
+    // The snapshot before the look: a ring between them is not lost (rt::Doorbell).
+    const std::uint32_t seen = done_.snapshot();
+    k = completed_.load(std::memory_order_acquire);
+    if (k != n) done_.wait(seen, kWaitNs);
+  }
   out.times.detect = monotonic_ns() - t0;
 }
 

@@ -7,12 +7,14 @@
 // identification, angles) then run on the calling thread. The output is exactly
 // FrameProcessor::process's: every camera has its own detector and blob list, and
 // detect_camera() is thread-safe between different cameras.
-// Per frame: the caller rings posted_ (C++20 atomic wait/notify: a futex on int-sized
-// atomics, no lock), then publishes the frame and a generation-tagged camera counter
+// Per frame: the caller rings posted_ (rt::Doorbell: a futex with a timeout, no lock),
+// then publishes the frame and a generation-tagged camera counter
 // (next_: generation << 32 | next camera); each thread claims a camera by compare-exchange
 // of next_ (a stale worker sees another generation or no camera left and claims nothing);
 // completed_ counts the cameras detected, and the caller returns when it reaches the
-// camera count, so the frame's views stay valid for every claim. No allocation after
+// camera count (the thread that completes the last camera rings done_), so the frame's
+// views stay valid for every claim. Every sleep is bounded (kWaitNs): a wake-up that were
+// ever lost costs one timeout, never a hang. No allocation after
 // construction. Timings are wall-clock, as in process(): `detect` is the time until
 // every camera of the frame was detected.
 // Wake-ups off the frame's time: warm() (called before the frame's files are read) rings
@@ -28,6 +30,7 @@
 #include <span>
 #include <thread>
 
+#include "rt/doorbell.h"
 #include "track/frame_processor.h"
 
 namespace mocap {
@@ -56,6 +59,7 @@ class ParallelDetect {
 
   static constexpr std::int64_t kWarmSpinNs = 20'000'000;  // longer than a frame's reading
   static constexpr std::int64_t kFinishSpinNs = 500'000;   // a few cameras' detection
+  static constexpr std::int64_t kWaitNs = 10'000'000;      // a sleep's safety net
 
   FrameProcessor& proc_;
   // The frame in hand: written by the caller before next_'s release store, read by a
@@ -64,7 +68,8 @@ class ParallelDetect {
   FrameOutput* out_ = nullptr;
   std::atomic<std::uint64_t> next_{0};       // generation << 32 | next camera to claim
   std::uint32_t generation_ = 0;             // the caller's last frame
-  std::atomic<std::uint32_t> posted_{0};     // the worker's doorbell: frames and warm()
+  rt::Doorbell posted_;                      // the worker's: frames, warm() and stop
+  rt::Doorbell done_;                        // the caller's: the frame's last camera
   std::atomic<std::uint32_t> completed_{0};  // cameras of this generation detected
   std::atomic<bool> stop_{false};
   std::thread worker_;

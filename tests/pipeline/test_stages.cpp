@@ -102,15 +102,45 @@ TEST(StageContext, LedgerOnlyGrowsAndKeepsTheFirstSequence) {
   context.retire(9);
   context.retire(4);  // an older drop retired late: the ledger stays at 9
   EXPECT_EQ(context.retired_plus_one(), 10u);
-  EXPECT_FALSE(context.triggering_done());
-  context.set_triggering_done();
-  EXPECT_TRUE(context.triggering_done());
   EXPECT_FALSE(context.stopping());
   context.request_stop();
   EXPECT_TRUE(context.stopping());
   context.reset();
   EXPECT_EQ(context.retired_plus_one(), 0u);
   EXPECT_FALSE(context.stopping());
+}
+
+TEST(StageContext, TheRunIsDrainedWhenEveryStageHandedOnWhatItWasGiven) {
+  PipelineOptions options;
+  StageContext context(options);
+  context.reset();
+  // Two frames to camera 0's detect stage, one to camera 1's.
+  context.note_handed_to_detect(0);
+  context.note_handed_to_detect(0);
+  context.note_handed_to_detect(1);
+  context.note_detected(0);
+  context.note_detected(1);
+  EXPECT_FALSE(context.detect_drained(2));
+  context.note_detected(0);
+  EXPECT_TRUE(context.detect_drained(2));
+  EXPECT_FALSE(context.capture_done());
+  context.set_capture_done(42);
+  EXPECT_TRUE(context.capture_done());
+  EXPECT_EQ(context.end_sequence(), 42u);
+  // Identify handed three messages on; publish is done with one, then with the other
+  // two (one published, one it skipped for it).
+  for (int i = 0; i < 3; ++i) context.note_handed_to_publish();
+  context.note_published(1);
+  EXPECT_FALSE(context.drained()) << "identify has not declared its end";
+  context.set_identify_done();
+  EXPECT_FALSE(context.drained()) << "two messages are still in publish's queue";
+  context.note_published(2);
+  EXPECT_TRUE(context.drained());
+  context.reset();  // a new run starts from nothing
+  EXPECT_FALSE(context.capture_done());
+  EXPECT_FALSE(context.drained());
+  EXPECT_TRUE(context.detect_drained(2));
+  EXPECT_EQ(context.end_sequence(), 0u);
 }
 
 // Forwards every call to a simulated camera; the test cameras below change a few.

@@ -16,7 +16,7 @@
 #include <cstdint>
 #include <ctime>
 
-namespace mocap::pipeline {
+namespace mocap::rt {
 
 class Doorbell {
  public:
@@ -59,4 +59,4 @@ class Doorbell {
   std::atomic<std::uint32_t> waiters_{0};
 };
 
-}  // namespace mocap::pipeline
+}  // namespace mocap::rt
