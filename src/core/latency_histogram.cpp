@@ -1,4 +1,5 @@
-// Design: see latency_histogram.h. Report-time code: walks the 2304 buckets.
+// Design: see latency_histogram.h. Report-time code: walks the 2304 buckets (or sorts the
+// offline samples).
 #include "core/latency_histogram.h"
 
 #include <algorithm>
@@ -7,12 +8,17 @@
 namespace mocap {
 namespace {
 
+// The rank of the q-th percentile among `total` samples (1-based): ceil(q * total), >= 1.
+std::uint64_t nearest_rank(std::uint64_t total, double q) {
+  const double want = std::ceil(q * static_cast<double>(total));
+  return std::max<std::uint64_t>(1, static_cast<std::uint64_t>(want));
+}
+
 // Nearest rank: the smallest value with at least ceil(q * count) samples at or below it.
 template <class CountAt>
 std::int64_t percentile_ns(std::uint64_t total, double q, std::int64_t max_ns, CountAt count_at) {
   if (total == 0) return 0;
-  const double want = std::ceil(q * static_cast<double>(total));
-  const std::uint64_t rank = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(want));
+  const std::uint64_t rank = nearest_rank(total, q);
   std::uint64_t seen = 0;
   for (std::size_t b = 0; b < LatencyHistogram::kBuckets; ++b) {
     seen += count_at(b);
@@ -22,6 +28,26 @@ std::int64_t percentile_ns(std::uint64_t total, double q, std::int64_t max_ns, C
 }
 
 }  // namespace
+
+LatencyStats LatencySamples::stats() const {
+  LatencyStats s;
+  s.count = samples_.size();
+  if (samples_.empty()) return s;
+  std::vector<std::int64_t> sorted = samples_;
+  std::sort(sorted.begin(), sorted.end());
+  const auto at = [&](double q) {
+    const std::uint64_t rank = std::min<std::uint64_t>(nearest_rank(s.count, q), s.count);
+    return static_cast<double>(sorted[static_cast<std::size_t>(rank - 1)]) * 1e-3;
+  };
+  s.p50_us = at(0.50);
+  s.p99_us = at(0.99);
+  s.p999_us = at(0.999);
+  s.max_us = static_cast<double>(sorted.back()) * 1e-3;
+  double sum_ns = 0.0;
+  for (const std::int64_t v : sorted) sum_ns += static_cast<double>(v);
+  s.mean_us = sum_ns / static_cast<double>(s.count) * 1e-3;
+  return s;
+}
 
 void LatencyHistogram::reset() noexcept {
   // relaxed: no reader relies on ordering between these fields (file comment).

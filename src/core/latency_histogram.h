@@ -12,6 +12,7 @@
 // writer thread was joined (join synchronises).
 // Percentiles are nearest-rank on the bucket counts and reported as the bucket's upper
 // bound clipped to the exact maximum: never below the true value, at most 1.6 % above.
+// Offline statistics, where every sample can be kept, use LatencySamples (exact).
 #pragma once
 
 #include <array>
@@ -42,6 +43,21 @@ struct LatencySnapshot {
   // of the interval is the upper bound of its highest non-empty bucket (clipped to max).
   LatencySnapshot since(const LatencySnapshot& earlier) const;
   LatencyStats stats() const;
+};
+
+// The offline form (`mocap track --stats`): every sample kept, so the percentiles are
+// the exact nearest-rank values (the histogram's may be up to 1/64 above). Offline code:
+// record() allocates as the run grows (8 bytes per sample; reserve() ahead), stats() sorts
+// a copy.
+class LatencySamples {
+ public:
+  void reserve(std::size_t n) { samples_.reserve(n); }
+  void record(std::int64_t ns) { samples_.push_back(ns < 0 ? 0 : ns); }
+  std::uint64_t count() const noexcept { return samples_.size(); }
+  LatencyStats stats() const;
+
+ private:
+  std::vector<std::int64_t> samples_;
 };
 
 class LatencyHistogram {

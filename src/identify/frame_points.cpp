@@ -2,8 +2,10 @@
 // points of its 27 neighbouring cells with a larger index, every bucket visited once) and
 // are sorted in place (std::sort allocates nothing); the neighbour lists are a CSR array
 // filled from the pairs, each list sorted by index (insertion sort: lists are short).
-// Blob occupancy uses a counter per possible int16 blob index so that acquire/release are
-// O(1) and exactly undo each other.
+// The partner lists come from the points' views chained per blob (last_view_ over the
+// frame's dense blob numbering): a view whose blob has earlier views shares it with their
+// points; a pair sharing blobs of several cameras is listed at its lowest shared camera
+// only. acquire/release exactly undo each other.
 #include "identify/frame_points.h"
 
 #include <algorithm>
@@ -53,7 +55,12 @@ FramePoints::FramePoints(int max_points, int cameras)
       adj_(pairs_.size() * 2, 0),
       cameras_(std::clamp(cameras, 1, kMaxCameras)),
       camera_mask_(cameras_ >= 32 ? ~CameraMask{0} : (CameraMask{1} << cameras_) - 1),
-      blob_uses_(static_cast<std::size_t>(cameras_) * kBlobSlots, 0) {}
+      blocked_(static_cast<std::size_t>(max_points), 0),
+      views_(static_cast<std::size_t>(max_points) * static_cast<std::size_t>(cameras_)),
+      last_view_(static_cast<std::size_t>(cameras_) * kBlobSlots, 0),
+      blob_start_(static_cast<std::size_t>(cameras_) + 1, 0),
+      part_start_(static_cast<std::size_t>(max_points) + 1, 0),
+      part_(pairs_.size() * 2, 0) {}
 
 std::array<std::int64_t, 3> FramePoints::cell_of(const Vec3& x) const noexcept {
   std::array<std::int64_t, 3> c{};
@@ -161,7 +168,9 @@ FramePoints::LoadStats FramePoints::load(const MeasuredPoint* pts, int n,
     valid_[s] = X_[s].allFinite() ? 1 : 0;
     if (!valid_[s]) ++stats.invalid;
     point_uses_[s] = 0;
+    blocked_[s] = 0;
   }
+  build_partners();
   // One cell for everything when the pair limit is unbounded (a plain O(n^2) build).
   cell_mm_ = !std::isfinite(max_pair_mm) ? 1e300 : std::max(max_pair_mm, 1e-3);
   build_grid();
@@ -211,44 +220,90 @@ bool FramePoints::exclusive(int i, int j) const noexcept {
   return blob_[static_cast<std::size_t>(i)].shares_blob(blob_[static_cast<std::size_t>(j)]);
 }
 
-bool FramePoints::available(int i) const noexcept {
-  const auto s = static_cast<std::size_t>(i);
-  if (!valid_[s] || point_uses_[s] != 0) return false;
-  const BlobRefs& refs = blob_[s];
-  for (CameraMask m = refs.mask(); m != 0; m &= m - 1) {
-    const int c = std::countr_zero(m);
-    if (blob_uses_[use_slot(c, refs[c])] != 0) return false;
+template <class F>
+void FramePoints::for_each_sharing(int views, F&& f) const noexcept {
+  for (int v = 0; v < views; ++v) {
+    const View& view = views_[static_cast<std::size_t>(v)];
+    const int i = view.point;
+    const BlobRefs& a = blob_[static_cast<std::size_t>(i)];
+    const CameraMask below = (CameraMask{1} << view.camera) - 1;
+    for (int u = view.prev_plus_one - 1; u >= 0;
+         u = views_[static_cast<std::size_t>(u)].prev_plus_one - 1) {
+      const int j = views_[static_cast<std::size_t>(u)].point;
+      const BlobRefs& b = blob_[static_cast<std::size_t>(j)];
+      bool lower = false;  // they share a blob of a lower camera: listed there
+      for (CameraMask m = a.mask() & b.mask() & below; m != 0 && !lower; m &= m - 1) {
+        const int c = std::countr_zero(m);
+        lower = a[c] == b[c];
+      }
+      if (!lower) f(i, j);
+    }
   }
-  return true;
 }
 
-int FramePoints::uses(int i) const noexcept {
-  const auto s = static_cast<std::size_t>(i);
-  int u = point_uses_[s];
-  blob_[s].for_each([&](int c, int b) { u = std::max<int>(u, blob_uses_[use_slot(c, b)]); });
-  return u;
+void FramePoints::build_partners() noexcept {
+  // The frame's blobs, numbered densely per camera.
+  std::fill(blob_start_.begin(), blob_start_.end(), 0);
+  for (int i = 0; i < n_; ++i) {
+    blob_[static_cast<std::size_t>(i)].for_each([&](int c, int b) {
+      auto& top = blob_start_[static_cast<std::size_t>(c) + 1];
+      top = std::max(top, b + 1);
+    });
+  }
+  for (std::size_t c = 1; c < blob_start_.size(); ++c) blob_start_[c] += blob_start_[c - 1];
+  // Each view chained to its blob's previous view (invalid points too: held, they block
+  // their partners).
+  int nv = 0;
+  for (int i = 0; i < n_; ++i) {
+    blob_[static_cast<std::size_t>(i)].for_each([&](int c, int b) {
+      std::int32_t& last =
+          last_view_[static_cast<std::size_t>(blob_start_[static_cast<std::size_t>(c)] + b)];
+      views_[static_cast<std::size_t>(nv)] =
+          View{last, static_cast<std::int16_t>(i), static_cast<std::int16_t>(c)};
+      last = ++nv;
+    });
+  }
+  std::fill(part_start_.begin(), part_start_.begin() + n_ + 1, 0);
+  for_each_sharing(nv, [&](int i, int j) {
+    ++part_start_[static_cast<std::size_t>(i) + 1];
+    ++part_start_[static_cast<std::size_t>(j) + 1];
+  });
+  for (int i = 0; i < n_; ++i)
+    part_start_[static_cast<std::size_t>(i) + 1] += part_start_[static_cast<std::size_t>(i)];
+  // Fill with a moving cursor per point (part_start_[i] temporarily), then restore.
+  for_each_sharing(nv, [&](int i, int j) {
+    part_[static_cast<std::size_t>(part_start_[static_cast<std::size_t>(i)]++)] =
+        static_cast<std::int16_t>(j);
+    part_[static_cast<std::size_t>(part_start_[static_cast<std::size_t>(j)]++)] =
+        static_cast<std::int16_t>(i);
+  });
+  for (int i = n_; i > 0; --i)
+    part_start_[static_cast<std::size_t>(i)] = part_start_[static_cast<std::size_t>(i) - 1];
+  part_start_[0] = 0;
+  // Zeroed for the next frame: only the blobs this frame used.
+  std::fill(last_view_.begin(), last_view_.begin() + blob_start_.back(), 0);
 }
 
 void FramePoints::acquire(int i) noexcept {
   const auto s = static_cast<std::size_t>(i);
   ++point_uses_[s];
-  blob_[s].for_each([&](int c, int b) { ++blob_uses_[use_slot(c, b)]; });
+  ++blocked_[s];
+  for (int e = part_start_[s]; e < part_start_[s + 1]; ++e)
+    ++blocked_[static_cast<std::size_t>(part_[static_cast<std::size_t>(e)])];
 }
 
 void FramePoints::release(int i) noexcept {
   const auto s = static_cast<std::size_t>(i);
   if (point_uses_[s] == 0) return;
   --point_uses_[s];
-  blob_[s].for_each([&](int c, int b) {
-    std::uint16_t& u = blob_uses_[use_slot(c, b)];
-    if (u > 0) --u;
-  });
+  --blocked_[s];
+  for (int e = part_start_[s]; e < part_start_[s + 1]; ++e)
+    --blocked_[static_cast<std::size_t>(part_[static_cast<std::size_t>(e)])];
 }
 
 void FramePoints::release_all() noexcept {
-  for (int i = 0; i < n_; ++i) {
-    while (point_uses_[static_cast<std::size_t>(i)] != 0) release(i);
-  }
+  std::fill(point_uses_.begin(), point_uses_.begin() + n_, 0);
+  std::fill(blocked_.begin(), blocked_.begin() + n_, 0);
 }
 
 }  // namespace mocap

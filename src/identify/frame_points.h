@@ -5,8 +5,13 @@
 // the points for radius queries (the temporal path's gates), and an occupancy state
 // (points and per-camera blobs in use) that the depth-first search and the multi-body
 // conflict resolution acquire and release. A point is available only when neither it
-// nor any blob it uses is taken, which enforces "at most one of mutually exclusive
-// candidates" and "a point belongs to at most one body" in one test.
+// nor any point sharing a blob with it is taken, which enforces "at most one of mutually
+// exclusive candidates" and "a point belongs to at most one body" in one test. The
+// points sharing a blob (each point's partners) are listed once per frame at load() (the
+// frame's blobs numbered densely per camera, each view chained to the blob's previous
+// one: linear in the views, no sort), so
+// the test is one counter per point (blocked: acquisitions of the point and of its
+// partners) and acquire/release touch the point and its few partners only.
 // The grid's cell is the longest pair, so a pair's two points lie in neighbouring cells:
 // building the pairs costs O(n * local density), not O(n^2), and a gate query visits at
 // most 8 cells. Cells are hashed into 2 * capacity buckets (a collision only adds
@@ -64,22 +69,39 @@ class FramePoints {
   int available_within(const Vec3& c, double radius_mm, std::int16_t* out, int cap) const noexcept;
 
   bool exclusive(int i, int j) const noexcept;
-  bool available(int i) const noexcept;
-  // How many acquisitions hold point i or one of its blobs (0: available if valid).
-  int uses(int i) const noexcept;
+  bool available(int i) const noexcept {
+    const auto s = static_cast<std::size_t>(i);
+    return valid_[s] != 0 && blocked_[s] == 0;
+  }
+  // Acquisitions of point i and of the points sharing a blob with it (0: available if
+  // valid; above 1 for a point one holds: someone else holds it or a blob of it).
+  int uses(int i) const noexcept { return blocked_[static_cast<std::size_t>(i)]; }
+  // The points sharing a blob with i (each once).
+  int partner_count(int i) const noexcept {
+    return part_start_[static_cast<std::size_t>(i) + 1] - part_start_[static_cast<std::size_t>(i)];
+  }
   void acquire(int i) noexcept;
   void release(int i) noexcept;
   void release_all() noexcept;
 
  private:
+  // One view of a point (load()'s partner lists): the point, its camera, and the
+  // previous view of the same blob + 1 (0: the blob's first).
+  struct View {
+    std::int32_t prev_plus_one;
+    std::int16_t point;
+    std::int16_t camera;
+  };
   static constexpr int kBlobSlots = 32768;  // every non-negative int16 blob index
   std::array<std::int64_t, 3> cell_of(const Vec3& x) const noexcept;
   std::uint32_t bucket_of(const std::array<std::int64_t, 3>& cell) const noexcept;
   void build_grid() noexcept;
   void build_pairs(double max2) noexcept;
-  static std::size_t use_slot(int camera, int blob) noexcept {
-    return static_cast<std::size_t>(camera) * kBlobSlots + static_cast<std::size_t>(blob);
-  }
+  void build_partners() noexcept;
+  // Calls f(i, j) once for every two points sharing a blob (listed at the lowest camera
+  // whose blob they share).
+  template <class F>
+  void for_each_sharing(int views, F&& f) const noexcept;
 
   int capacity_;
   int n_ = 0;
@@ -100,8 +122,16 @@ class FramePoints {
   std::vector<std::int32_t> adj_start_;  // CSR neighbour lists
   std::vector<std::int16_t> adj_;
   int cameras_;
-  CameraMask camera_mask_;                // the cameras 0..cameras_-1
-  std::vector<std::uint16_t> blob_uses_;  // camera c, blob b at c * kBlobSlots + b
+  CameraMask camera_mask_;              // the cameras 0..cameras_-1
+  std::vector<std::uint16_t> blocked_;  // acquisitions of the point and its partners
+  std::vector<View> views_;             // every point's views, in point order
+  // The last view + 1 of each blob of this frame: camera c's blob b at blob_start_[c] + b
+  // (blob_start_: the frame's largest blob index + 1 per camera, summed; kept zeroed
+  // between frames).
+  std::vector<std::int32_t> last_view_;
+  std::vector<std::int32_t> blob_start_;
+  std::vector<std::int32_t> part_start_;  // CSR partner lists
+  std::vector<std::int16_t> part_;
 };
 
 }  // namespace mocap

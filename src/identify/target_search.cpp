@@ -10,7 +10,6 @@
 
 namespace mocap {
 namespace {
-constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr auto kSeedLess = [](const auto& x, const auto& y) { return x.disc_mm < y.disc_mm; };
 }  // namespace
 
@@ -94,11 +93,12 @@ double TargetSearch::score_of(int m, double sum_sq) const noexcept {
   return std::sqrt(sum_sq + m * floor2) * model_->score_factor[static_cast<std::size_t>(m)];
 }
 
-double TargetSearch::lower_bound(int m_now, int m_max, double sum_sq) const noexcept {
-  double lb = kInf;
-  for (int m = std::max(m_now, config_.min_markers); m <= m_max; ++m)
-    lb = std::min(lb, score_of(m, sum_sq));
-  return lb;
+bool TargetSearch::may_beat(int m_now, int m_max, double sum_sq, double limit) const noexcept {
+  // Whether the lowest of these scores is below limit: the first one that is settles it
+  // (the most markers first, usually the lowest score).
+  for (int m = m_max; m >= std::max(m_now, config_.min_markers); --m)
+    if (score_of(m, sum_sq) < limit) return true;
+  return false;
 }
 
 bool TargetSearch::was_seed(int c, int p, int a, int q) const noexcept {
@@ -134,8 +134,8 @@ void TargetSearch::extend(int level, double sum_sq) noexcept {
   if (m_max < config_.min_markers) return;
   if (rival_pass_) {
     const double limit = std::min(config_.ambiguity_ratio * best_->score, best_->rival_score);
-    if (!(lower_bound(m_, m_max, sum_sq) < limit)) return;
-  } else if (best_->found && !(lower_bound(m_, m_max, sum_sq) < best_->score)) {
+    if (!may_beat(m_, m_max, sum_sq, limit)) return;
+  } else if (best_->found && !may_beat(m_, m_max, sum_sq, best_->score)) {
     return;
   }
 

@@ -91,7 +91,9 @@ class TargetSearch {
   void record(double score, const RigidFit& fit) noexcept;
   bool contradicts_best() noexcept;
   double score_of(int m, double sum_sq) const noexcept;
-  double lower_bound(int m_now, int m_max, double sum_sq) const noexcept;
+  // Whether some completion with m_now..m_max markers may score below limit (a lower
+  // bound: |r| cannot shrink when points are added to a least-squares fit).
+  bool may_beat(int m_now, int m_max, double sum_sq, double limit) const noexcept;
   bool was_seed(int c, int p, int a, int q) const noexcept;
   void mark_seed(int seed_index) noexcept;
 

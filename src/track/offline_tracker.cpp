@@ -68,6 +68,7 @@ Expected<OfflineTrackResult> track_recording(const OfflineTrackOptions& opt) {
   const auto& frames = rec->frames();
   OfflineTrackResult result;
   result.stats = std::make_unique<TrackStats>();
+  result.stats->reserve(rec->frames().size());
   for (const MarkerTarget& t : targets->bodies) result.body_names.push_back(t.name);
   result.body_found.assign(targets->bodies.size(), 0);
   if (model) {
@@ -217,7 +218,7 @@ std::string format_track_summary(const OfflineTrackResult& r) {
     }
   }
   if (r.stats) {
-    const std::pair<const char*, const LatencyHistogram*> stages[] = {
+    const std::pair<const char*, const LatencySamples*> stages[] = {
         {"load", &r.stats->load},
         {"detect", &r.stats->detect},
         {"triangulate", &r.stats->triangulate},

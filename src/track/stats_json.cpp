@@ -35,13 +35,9 @@ std::string stats_to_json(const TrackStats& stats) {
   std::snprintf(buf, sizeof buf, "{\"frames\": %lld,\n \"stages\": {",
                 static_cast<long long>(stats.frames));
   out += buf;
-  const std::pair<const char*, const LatencyHistogram*> stages[] = {
-      {"load", &stats.load},
-      {"detect", &stats.detect},
-      {"triangulate", &stats.triangulate},
-      {"identify", &stats.identify},
-      {"angles", &stats.angles},
-      {"frame", &stats.frame}};
+  const std::pair<const char*, const LatencySamples*> stages[] = {
+      {"load", &stats.load},         {"detect", &stats.detect}, {"triangulate", &stats.triangulate},
+      {"identify", &stats.identify}, {"angles", &stats.angles}, {"frame", &stats.frame}};
   bool first = true;
   for (const auto& [name, rec] : stages) {
     const LatencyStats s = rec->stats();

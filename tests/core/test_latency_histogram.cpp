@@ -1,7 +1,8 @@
 // LatencyHistogram: bucket arithmetic (every value lands in a bucket whose bounds contain
 // it, buckets at most 1/64 wide), percentiles against exact nearest-rank percentiles of
 // random samples (never below, at most 1/64 above), interval snapshots, and a reader
-// thread running while the writer records (TSan: no race, monotone counts).
+// thread running while the writer records (TSan: no race, monotone counts); the offline
+// LatencySamples' percentiles are the exact nearest-rank values.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -69,6 +70,53 @@ TEST(LatencyHistogram, PercentilesMatchExactNearestRankWithin1Point6Percent) {
   for (std::int64_t x : v) sum += static_cast<double>(x);
   EXPECT_NEAR(s.mean_us, sum / static_cast<double>(v.size()) * 1e-3, 1e-6);
   EXPECT_DOUBLE_EQ(h.percentile_us(0.99), s.p99_us);
+}
+
+TEST(LatencySamples, PercentilesAreTheExactNearestRankValues) {
+  std::mt19937_64 rng(12);
+  std::lognormal_distribution<double> dist(13.0, 0.6);
+  LatencySamples samples;
+  EXPECT_EQ(samples.stats().count, 0u);
+  std::vector<std::int64_t> v;
+  for (int n : {1, 2, 3, 99, 100, 101, 150, 1000}) {
+    samples = LatencySamples{};
+    v.clear();
+    samples.reserve(static_cast<std::size_t>(n));
+    for (int i = 0; i < n; ++i) {
+      v.push_back(static_cast<std::int64_t>(dist(rng)));
+      samples.record(v.back());
+    }
+    std::vector<std::int64_t> sorted = v;
+    std::sort(sorted.begin(), sorted.end());
+    const auto exact_us = [&](double q) {  // the smallest value with >= ceil(q n) at or below
+      const auto rank = static_cast<std::size_t>(std::ceil(q * static_cast<double>(n)));
+      return static_cast<double>(sorted[std::max<std::size_t>(rank, 1) - 1]) * 1e-3;
+    };
+    const LatencyStats s = samples.stats();
+    ASSERT_EQ(s.count, static_cast<std::uint64_t>(n));
+    EXPECT_DOUBLE_EQ(s.p50_us, exact_us(0.5)) << n;
+    EXPECT_DOUBLE_EQ(s.p99_us, exact_us(0.99)) << n;
+    EXPECT_DOUBLE_EQ(s.p999_us, exact_us(0.999)) << n;
+    EXPECT_DOUBLE_EQ(s.max_us, static_cast<double>(sorted.back()) * 1e-3);
+    // The histogram of the same samples: never below, at most 1/64 above.
+    H h;
+    for (std::int64_t x : v) h.record(x);
+    EXPECT_GE(h.stats().p99_us, s.p99_us - 1e-9);
+    EXPECT_LE(h.stats().p99_us, s.p99_us * (1.0 + 1.0 / 64.0) + 1e-3);
+  }
+  // 150 frames of 1..150 us in any order: the p99 is the second-largest (rank 149), the
+  // p50 rank 75, and a negative time counts as 0.
+  LatencySamples frames;
+  std::vector<int> us(150);
+  for (int i = 0; i < 150; ++i) us[static_cast<std::size_t>(i)] = i + 1;
+  std::shuffle(us.begin(), us.end(), rng);
+  for (int x : us) frames.record(std::int64_t{x} * 1000);
+  EXPECT_DOUBLE_EQ(frames.stats().p99_us, 149.0);
+  EXPECT_DOUBLE_EQ(frames.stats().p50_us, 75.0);
+  EXPECT_DOUBLE_EQ(frames.stats().max_us, 150.0);
+  LatencySamples negative;
+  negative.record(-5);
+  EXPECT_DOUBLE_EQ(negative.stats().max_us, 0.0);
 }
 
 TEST(LatencyHistogram, IntervalSnapshotHoldsOnlyTheNewSamples) {

@@ -1,0 +1,93 @@
+// FramePoints' occupancy against its definition, on random frames where points share
+// blobs often (few blobs per camera): after every acquire and release, a point is
+// available exactly when it is valid and neither it nor any point sharing a blob with it
+// is held, uses() is the acquisitions of the point and of the points sharing a blob with
+// it, each sharing point is a partner once (however many blobs the two share), and
+// release_all() and the next load() start from nothing.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include "identify/frame_points.h"
+
+namespace mocap {
+namespace {
+
+struct RandomFrame {
+  std::vector<MeasuredPoint> pts;
+};
+
+RandomFrame random_frame(std::mt19937_64& rng, int n, int cameras, int blobs_per_camera) {
+  RandomFrame f;
+  std::uniform_real_distribution<double> x(-500.0, 500.0);
+  std::uniform_int_distribution<int> blob(-1, blobs_per_camera - 1);  // -1: not seen
+  std::uniform_int_distribution<int> percent(0, 99);
+  for (int i = 0; i < n; ++i) {
+    MeasuredPoint p;
+    p.X_world = Vec3(x(rng), x(rng), x(rng));
+    if (percent(rng) < 5) p.X_world.x() = std::numeric_limits<double>::quiet_NaN();
+    for (int c = 0; c < cameras; ++c) p.blob_index.set(static_cast<std::size_t>(c), blob(rng));
+    f.pts.push_back(p);
+  }
+  return f;
+}
+
+TEST(FramePoints, OccupancyFollowsItsDefinitionUnderRandomAcquireAndRelease) {
+  std::mt19937_64 rng(11);
+  constexpr int kCameras = 6;
+  FramePoints frame(80, kCameras);
+  int checks = 0, blocked_by_partner = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    const int n = 10 + trial % 50;
+    const RandomFrame f = random_frame(rng, n, kCameras, 3 + trial % 12);
+    frame.load(f.pts.data(), n, 300.0);
+    std::vector<int> held(static_cast<std::size_t>(n), 0);
+    std::vector<int> stack;
+    const auto check = [&] {
+      for (int i = 0; i < n; ++i) {
+        const auto s = static_cast<std::size_t>(i);
+        int ref = held[s], partners = 0;
+        for (int j = 0; j < n; ++j) {
+          if (j == i ||
+              !f.pts[s].blob_index.shares_blob(f.pts[static_cast<std::size_t>(j)].blob_index))
+            continue;
+          ++partners;
+          ref += held[static_cast<std::size_t>(j)];
+        }
+        const bool valid = f.pts[s].X_world.allFinite();
+        ASSERT_EQ(frame.partner_count(i), partners) << "point " << i;
+        ASSERT_EQ(frame.uses(i), ref) << "point " << i;
+        ASSERT_EQ(frame.available(i), valid && ref == 0) << "point " << i;
+        blocked_by_partner += held[s] == 0 && ref > 0;
+        ++checks;
+      }
+    };
+    std::uniform_int_distribution<int> point(0, n - 1);
+    for (int op = 0; op < 40; ++op) {
+      if (!stack.empty() && rng() % 3 == 0) {  // release the last one taken
+        frame.release(stack.back());
+        --held[static_cast<std::size_t>(stack.back())];
+        stack.pop_back();
+      } else {  // acquire any point, available or not (the conflict resolution does)
+        const int p = point(rng);
+        frame.acquire(p);
+        ++held[static_cast<std::size_t>(p)];
+        stack.push_back(p);
+      }
+      check();
+    }
+    frame.release(point(rng) == 0 ? 0 : n - 1);  // a release of a point not held: no-op
+    if (held[0] == 0 && held[static_cast<std::size_t>(n - 1)] == 0) check();
+    frame.release_all();
+    std::fill(held.begin(), held.end(), 0);
+    check();
+  }
+  EXPECT_GT(checks, 10000);
+  EXPECT_GT(blocked_by_partner, 100) << "the frames share too few blobs to test anything";
+}
+
+}  // namespace
+}  // namespace mocap
