@@ -69,7 +69,7 @@ bool CaptureStage::tail_pending(std::uint64_t fired) const noexcept {
   return false;
 }
 
-void CaptureStage::take_tail(std::uint64_t fired, std::int64_t last_trigger_ns,
+void CaptureStage::take_tail(bool triggered_mode, std::uint64_t fired, std::int64_t last_trigger_ns,
                              bool& end_of_stream) noexcept {
   rt::Doorbell& bell = context_.bell(StageId::kCapture);
   const std::int64_t deadline = monotonic_ns() + kLateFrameNs;
@@ -77,7 +77,7 @@ void CaptureStage::take_tail(std::uint64_t fired, std::int64_t last_trigger_ns,
     const std::uint32_t seen = bell.snapshot();
     std::uint64_t last = 0;
     for (int c = 0; c < camera_count_; ++c)
-      (void)poll_camera(c, 0, fired != 0, last_trigger_ns, last, end_of_stream, false);
+      (void)poll_camera(c, 0, triggered_mode, last_trigger_ns, last, end_of_stream, false);
     if (!tail_pending(fired)) break;
     bell.wait(seen, kLockstepPollNs);
     release_returned();
@@ -152,7 +152,7 @@ void CaptureStage::run() noexcept {
     if (end_of_stream ||
         (triggered_mode && o.max_frames != 0 && k.triggered.get() >= o.max_frames)) {
       if (!context_.capture_done()) {
-        take_tail(triggered_mode ? fired : 0, last_trigger_ns, end_of_stream);
+        take_tail(triggered_mode, triggered_mode ? fired : 0, last_trigger_ns, end_of_stream);
         finish_capture();
       }
       rt::Doorbell& bell = context_.bell(StageId::kCapture);

@@ -93,7 +93,8 @@ class CaptureStage {
   // The last triggers' frames that came after their dequeue pass (a slow camera): taken
   // until every camera delivered its last one or ended, for at most kLateFrameNs, so that
   // the last sets complete. fired: the triggers of this run (0: free-running cameras).
-  void take_tail(std::uint64_t fired, std::int64_t last_trigger_ns, bool& end_of_stream) noexcept;
+  void take_tail(bool triggered_mode, std::uint64_t fired, std::int64_t last_trigger_ns,
+                 bool& end_of_stream) noexcept;
   bool tail_pending(std::uint64_t fired) const noexcept;
   std::uint64_t delivered_end_ = 0;  // highest sequence dequeued + 1 (this thread)
   std::array<std::uint64_t, kMaxCameras> camera_end_{};  // the same per camera (this thread)

@@ -124,6 +124,7 @@ class StageContext {
     end_sequence_.store(end_sequence, std::memory_order_relaxed);  // published below
     // release: a thread that sees capture_done() sees the ledger and end_sequence.
     capture_done_.store(true, std::memory_order_release);
+    bell(StageId::kIdentify).ring();  // it settles the run's end without its idle wait
   }
   bool capture_done() const noexcept {
     return capture_done_.load(std::memory_order_acquire);  // see set_capture_done()

@@ -89,7 +89,9 @@ TEST(EndToEnd, SimCamerasToUdpClientWithGroundTruthAndGapAccounting) {
   // (the pipeline also counts frames lost before the first published one, e.g. skipped
   // by a detector that a loaded machine delayed at start, and after the last).
   const std::uint64_t dropped = counter(st, "frames_dropped");
-  EXPECT_GT(counter(st, "publish_skipped"), 0u) << report;
+  // The stalls drop frames at publish; on a machine slower than the trigger (TSan) the
+  // newest-first stages before it drop them first. Either way there are gaps to account.
+  EXPECT_GT(dropped, 0u) << report;
   EXPECT_EQ(dropped, counter(st, "frames_unpaired") + counter(st, "identify_skipped") +
                          counter(st, "identify_no_slot") + counter(st, "publish_skipped"));
   const std::uint64_t first = record[0].sequence;
