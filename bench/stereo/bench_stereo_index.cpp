@@ -63,8 +63,10 @@ void run_rig_stage(benchmark::State& state, const test::StagePath& path) {
       static_cast<double>(std::max<std::uint64_t>(1, stage.merger.counters().frames));
   state.counters["hypotheses_per_frame"] =
       static_cast<double>(stage.merger.counters().hypotheses) / frames_run;
-  std::uint64_t settled = stage.merger.counters().settled;  // lists: the merge drops them
-  for (const StereoTriangulator& st : stage.pairs) settled += st.counters().settled_pairs;
+  // Settled blobs: the a-blobs the pairs searched among unsettled b-blobs only (pair by
+  // pair), or the candidates the merge dropped (lists).
+  std::uint64_t settled = stage.merger.counters().settled;
+  for (const StereoTriangulator& st : stage.pairs) settled += st.counters().settled_blobs;
   state.counters["settled_per_frame"] = static_cast<double>(settled) / frames_run;
 }
 

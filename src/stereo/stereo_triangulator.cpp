@@ -89,13 +89,14 @@ Expected<StereoTriangulator> StereoTriangulator::create(const Rig& rig, const St
   t.obs_a_.resize(cap);
   t.obs_b_.resize(cap);
   t.keys_b_.resize(cap);
+  t.keys_b_open_.resize(cap);
   t.use_a_.assign(cap, 0);
   t.use_b_.assign(cap, 0);
   return t;
 }
 
 void StereoTriangulator::prepare(const UndistortedBlobs& blobs, int n, int camera,
-                                 std::vector<Observation>& obs) noexcept {
+                                 std::vector<Observation>& obs, const int* skip) noexcept {
   const CameraModel& cam = camera == 0 ? cam_a_model_ : cam_b_model_;
   const double f_min = std::min(cam.fx, cam.fy);
   for (int i = 0; i < n; ++i) {
@@ -110,6 +111,7 @@ void StereoTriangulator::prepare(const UndistortedBlobs& blobs, int n, int camer
     }
     const Vec2& xn = blobs.xn[i];
     o.valid = true;
+    if (skip != nullptr && skip[i] >= 0) continue;
     o.s = to_scaled(cam, xn);
     // The ray in camera-a coordinates (its length does not change the plane).
     Vec3 r(xn.x(), xn.y(), 1.0);
@@ -147,10 +149,6 @@ void StereoTriangulator::try_pair(int i, int j, PointList& out, int capacity) no
   const double tol = config_.epipolar_tolerance_px;
   if (!(d_a <= tol && d_b <= tol)) return;
   ++counters_.pairs_in_tolerance;
-  if (settled_.a != nullptr && settled_pair(settled_.a[i], settled_.b[j])) {
-    ++counters_.settled_pairs;
-    return;
-  }
 
   Vec2 sa_c, sb_c;
   niter2_correct(geometry_.F_s, a.s, b.s, sa_c, sb_c);
@@ -199,10 +197,10 @@ void StereoTriangulator::try_pair(int i, int j, PointList& out, int capacity) no
   out.push_back(p);
 }
 
-void StereoTriangulator::scan_range(int i, double lo, double hi, PointList& out,
-                                    int capacity) noexcept {
-  const SortKey* first = keys_b_.data();
-  const SortKey* last = first + n_b_;
+void StereoTriangulator::scan_range(int i, const SortKey* keys, int n, double lo, double hi,
+                                    PointList& out, int capacity) noexcept {
+  const SortKey* first = keys;
+  const SortKey* last = first + n;
   const SortKey* it =
       std::lower_bound(first, last, lo, [](const SortKey& k, double v) { return k.key < v; });
   for (; it != last && it->key <= hi; ++it) try_pair(i, it->index, out, capacity);
@@ -245,17 +243,24 @@ bool StereoTriangulator::process(const UndistortedBlobs& a, const UndistortedBlo
   }
   n_a_ = n_a;
   n_b_ = n_b;
-  prepare(a, n_a, 0, obs_a_);
   prepare(b, n_b, 1, obs_b_);
   std::fill_n(use_a_.begin(), n_a, std::uint16_t{0});
   std::fill_n(use_b_.begin(), n_b, std::uint16_t{0});
   const int capacity = std::min(out.capacity(), config_.max_candidates);
 
+  // A settled a-blob pairs only with unsettled b-blobs: two settled blobs are no candidate.
+  const auto settled_a = [&](int i) noexcept {
+    return settled_.a != nullptr && settled_.a[i] >= 0;
+  };
   if (config_.method == MatchMethod::kExhaustive) {
+    prepare(a, n_a, 0, obs_a_);
     for (int i = 0; i < n_a; ++i) {
       if (!obs_a_[static_cast<std::size_t>(i)].valid) continue;
+      const bool open_only = settled_a(i);
+      counters_.settled_blobs += open_only ? 1u : 0u;
       for (int j = 0; j < n_b; ++j)
-        if (obs_b_[static_cast<std::size_t>(j)].valid) try_pair(i, j, out, capacity);
+        if (obs_b_[static_cast<std::size_t>(j)].valid && !(open_only && settled_.b[j] >= 0))
+          try_pair(i, j, out, capacity);
     }
   } else {
     int k = 0;
@@ -266,16 +271,32 @@ bool StereoTriangulator::process(const UndistortedBlobs& a, const UndistortedBlo
     n_b_ = k;
     std::sort(keys_b_.begin(), keys_b_.begin() + k,
               [](const SortKey& x, const SortKey& y) { return x.key < y.key; });
+    // The settled a-blobs search the unsettled b-blobs' keys (in the same order).
+    int k_open = 0;
+    if (settled_.a != nullptr)
+      for (int r = 0; r < k; ++r)
+        if (settled_.b[keys_b_[static_cast<std::size_t>(r)].index] < 0)
+          keys_b_open_[static_cast<std::size_t>(k_open++)] = keys_b_[static_cast<std::size_t>(r)];
+    // With no unsettled b-blob, a settled a-blob searches nothing: no window for it.
+    prepare(a, n_a, 0, obs_a_, k_open == 0 ? settled_.a : nullptr);
     for (int i = 0; i < n_a; ++i) {
       const Observation& o = obs_a_[static_cast<std::size_t>(i)];
       if (!o.valid) continue;
+      const SortKey* keys = keys_b_.data();
+      int n = k;
+      if (settled_a(i)) {
+        ++counters_.settled_blobs;
+        keys = keys_b_open_.data();
+        n = k_open;
+        if (n == 0) continue;
+      }
       if (o.whole) {
-        scan_range(i, -1.0, 4.0, out, capacity);  // the whole pencil
-      } else if (o.lo > o.hi) {                   // through 0 (= pi): both ends of the keys
-        scan_range(i, 0.0, o.hi, out, capacity);
-        scan_range(i, o.lo, 2.0, out, capacity);
+        scan_range(i, keys, n, -1.0, 4.0, out, capacity);  // the whole pencil
+      } else if (o.lo > o.hi) {  // through 0 (= pi): both ends of the keys
+        scan_range(i, keys, n, 0.0, o.hi, out, capacity);
+        scan_range(i, keys, n, o.lo, 2.0, out, capacity);
       } else {
-        scan_range(i, o.lo, o.hi, out, capacity);
+        scan_range(i, keys, n, o.lo, o.hi, out, capacity);
       }
     }
   }

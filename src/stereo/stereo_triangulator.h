@@ -13,7 +13,9 @@
 //   Search: the blobs of camera b are sorted by the angle of their epipolar plane about
 //   the baseline (a pseudo-angle, monotone in it: no trigonometry per blob); a blob of
 //   camera a only visits the b-blobs whose plane angle lies in a window that provably
-//   contains every pair within tolerance, O((n+m) log m + k).
+//   contains every pair within tolerance, O((n+m) log m + k). Given SettledBlobs (an N-view
+//   rig's later pairs), a settled a-blob searches a copy of the keys holding only the
+//   unsettled b-blobs: two settled blobs are never looked at.
 //   MatchMethod::kExhaustive (all n*m pairs) gives the same set; kept for testing and
 //   benchmarks.
 // Capacity is fixed in create(); process() is noexcept and allocation-free. Failures
@@ -55,7 +57,7 @@ struct StereoCounters {
   std::array<std::uint64_t, 2> points_overflow{};   // blobs beyond max_points_per_camera
   std::array<std::uint64_t, 2> undistort_failed{};  // blobs whose undistortion failed
   std::uint64_t pairs_in_tolerance = 0;             // pairs passing the epipolar test
-  std::uint64_t settled_pairs = 0;                  // of them two settled blobs (not tried)
+  std::uint64_t settled_blobs = 0;                  // a-blobs settled: search open b-blobs only
   std::uint64_t rejected_degenerate = 0;            // parallel rays (on the baseline / at infinity)
   std::uint64_t rejected_cheirality = 0;            // behind a camera
   std::uint64_t rejected_depth = 0;                 // outside [min_depth_mm, max_depth_mm]
@@ -76,7 +78,7 @@ struct StereoCounters {
       undistort_failed[i] += o.undistort_failed[i];
     }
     pairs_in_tolerance += o.pairs_in_tolerance;
-    settled_pairs += o.settled_pairs;
+    settled_blobs += o.settled_blobs;
     rejected_degenerate += o.rejected_degenerate;
     rejected_cheirality += o.rejected_cheirality;
     rejected_depth += o.rejected_depth;
@@ -132,10 +134,14 @@ class StereoTriangulator {
   };
 
   StereoTriangulator() = default;
-  void prepare(const UndistortedBlobs& blobs, int n, int camera,
-               std::vector<Observation>& obs) noexcept;
+  // The observations of one camera's blobs; a blob with skip[i] >= 0 (skip non-null) is
+  // marked valid only, with nothing computed (a settled a-blob with no b-blob to search).
+  void prepare(const UndistortedBlobs& blobs, int n, int camera, std::vector<Observation>& obs,
+               const int* skip = nullptr) noexcept;
   void try_pair(int i, int j, PointList& out, int capacity) noexcept;
-  void scan_range(int i, double lo, double hi, PointList& out, int capacity) noexcept;
+  // Tries blob i of camera a with the b-blobs keys[0..n) whose key lies in [lo, hi].
+  void scan_range(int i, const SortKey* keys, int n, double lo, double hi, PointList& out,
+                  int capacity) noexcept;
 
   StereoConfig config_;
   CameraModel cam_a_model_;
@@ -152,6 +158,7 @@ class StereoTriangulator {
   std::vector<Observation> obs_a_;
   std::vector<Observation> obs_b_;
   std::vector<SortKey> keys_b_;
+  std::vector<SortKey> keys_b_open_;  // keys_b_'s unsettled blobs (settled a-blobs search these)
   std::vector<std::uint16_t> use_a_;
   std::vector<std::uint16_t> use_b_;
   SettledBlobs settled_;  // this frame's (process())

@@ -51,8 +51,9 @@ using PointList = BoundedList<Point3, int>;
 // Blobs of the pair's cameras that earlier pairs of the frame already settled (the N-view
 // merge, multiview.h "Settled blobs"): per blob (the first max_points_per_camera of each
 // camera) the point that settled it, -1: none. A pair of two settled blobs is no
-// candidate (the stereo stage counts it in settled_pairs, the merge in settled): it is
-// that point again, or a ghost of two points. nullptr: nothing settled.
+// candidate (the stereo stage never looks at it: a settled a-blob searches the unsettled
+// b-blobs only, counted in settled_blobs; the merge, given lists, counts it in settled):
+// it is that point again, or a ghost of two points. nullptr: nothing settled.
 inline bool settled_pair(int settled_a, int settled_b) noexcept {
   return settled_a >= 0 && settled_b >= 0;
 }

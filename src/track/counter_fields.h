@@ -87,7 +87,7 @@ inline constexpr std::array<CounterField<StereoCounters>, 15> kStereoFields = {{
        return s.undistort_failed[0] + s.undistort_failed[1];
      }},
     MOCAP_COUNTER_FIELD(StereoCounters, pairs_in_tolerance),
-    MOCAP_COUNTER_FIELD(StereoCounters, settled_pairs),
+    MOCAP_COUNTER_FIELD(StereoCounters, settled_blobs),
     MOCAP_COUNTER_FIELD(StereoCounters, rejected_degenerate),
     MOCAP_COUNTER_FIELD(StereoCounters, rejected_cheirality),
     MOCAP_COUNTER_FIELD(StereoCounters, rejected_depth),

@@ -80,7 +80,7 @@ TEST(StereoIndex, IndexedPathEqualsThePreviousAndTheBruteForceOnRandomScenes) {
     so.duplicate = s % 3 == 2 ? 0.02 : 0.0;
     test::RigStereoStage fresh(rig, test::kIndexedPath), previous(rig, test::kLinearMergePath),
         brute(rig, test::kBruteForcePath), pair_undistort(rig, test::kPairUndistortPath);
-    std::uint64_t skipped_before = 0, settled_before = 0;
+    std::uint64_t settled_before = 0;
     for (int f = 0; f < 2; ++f) {
       const auto px = test::humanoid_frame(rig, so, rng);
       fresh.run(px);
@@ -89,7 +89,8 @@ TEST(StereoIndex, IndexedPathEqualsThePreviousAndTheBruteForceOnRandomScenes) {
       pair_undistort.run(px);
       SCOPED_TRACE(::testing::Message() << "scene " << s << " frame " << f << ", " << cameras
                                         << " cameras, " << so.markers << " markers");
-      std::uint64_t skipped = 0;  // settled pairs the fresh path's pairs did not try
+      // Candidates the fresh path's pairs emitted, and the previous path's (every pair).
+      std::uint64_t emitted = 0, emitted_all = 0;
       for (std::size_t k = 0; k < fresh.pairs.size(); ++k) {
         // The shared undistortion equals every pair's own (both pair by pair).
         const PointList& a = fresh.pair_out[k];
@@ -97,16 +98,16 @@ TEST(StereoIndex, IndexedPathEqualsThePreviousAndTheBruteForceOnRandomScenes) {
         ASSERT_EQ(a.size(), u.size()) << "pair " << k;
         for (int i = 0; i < a.size(); ++i) ASSERT_TRUE(identical(a[i], u[i])) << "pair " << k;
         ASSERT_TRUE(same_counters(fresh.pairs[k].counters(), pair_undistort.pairs[k].counters()));
-        skipped += fresh.pairs[k].counters().settled_pairs;
+        emitted += static_cast<std::uint64_t>(a.size());
+        emitted_all += static_cast<std::uint64_t>(previous.pair_out[k].size());
         // The sweep finds the n*m loop's pairs (both given as lists: every pair tried).
         const auto sa = sorted(previous.pair_out[k]), sb = sorted(brute.pair_out[k]);
         ASSERT_EQ(sa.size(), sb.size()) << "pair " << k;
         for (std::size_t i = 0; i < sa.size(); ++i) ASSERT_TRUE(identical(sa[i], sb[i]));
       }
-      // The candidates the merge of the lists found settled, the pairs skipped (with the
-      // pairs of settled blobs that a later check of the pair would have rejected).
-      ASSERT_GE(skipped - skipped_before, previous.merger.counters().settled - settled_before);
-      skipped_before = skipped;
+      // The candidates the merge of the lists found settled are exactly those the pairs
+      // given SettledBlobs did not emit.
+      ASSERT_EQ(emitted_all - emitted, previous.merger.counters().settled - settled_before);
       settled_before = previous.merger.counters().settled;
       ASSERT_EQ(fresh.out.size(), previous.out.size());
       for (int i = 0; i < fresh.out.size(); ++i)
