@@ -29,7 +29,27 @@ std::int64_t percentile_ns(std::uint64_t total, double q, std::int64_t max_ns, C
 
 }  // namespace
 
+LatencySamples::LatencySamples(std::size_t max_exact)
+    : max_exact_(max_exact), histogram_(std::make_unique<LatencyHistogram>()) {}
+LatencySamples::~LatencySamples() = default;
+LatencySamples::LatencySamples(LatencySamples&&) noexcept = default;
+LatencySamples& LatencySamples::operator=(LatencySamples&&) noexcept = default;
+
+void LatencySamples::reserve(std::size_t n) { samples_.reserve(std::min(n, max_exact_)); }
+
+void LatencySamples::record(std::int64_t ns) {
+  if (ns < 0) ns = 0;
+  if (!histogram_) histogram_ = std::make_unique<LatencyHistogram>();  // moved from
+  histogram_->record(ns);
+  if (samples_.size() < max_exact_) samples_.push_back(ns);
+}
+
+std::uint64_t LatencySamples::count() const noexcept {
+  return histogram_ ? histogram_->count() : 0;
+}
+
 LatencyStats LatencySamples::stats() const {
+  if (!exact()) return histogram_->stats();
   LatencyStats s;
   s.count = samples_.size();
   if (samples_.empty()) return s;

@@ -18,6 +18,7 @@
 #include <array>
 #include <atomic>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 namespace mocap {
@@ -45,19 +46,33 @@ struct LatencySnapshot {
   LatencyStats stats() const;
 };
 
-// The offline form (`mocap track --stats`): every sample kept, so the percentiles are
-// the exact nearest-rank values (the histogram's may be up to 1/64 above). Offline code:
-// record() allocates as the run grows (8 bytes per sample; reserve() ahead), stats() sorts
-// a copy.
+class LatencyHistogram;
+
+// The offline form (`mocap track --stats`): the samples are kept, so the percentiles are
+// the exact nearest-rank values (the histogram's may be up to 1/64 above), up to
+// max_exact samples (8 bytes each; by default 2^20, 8 MiB: 2.9 hours at 100 fps). Every
+// sample also goes into a histogram, whose percentiles stats() reports once a run has
+// more (exact() false): the memory stays bounded however long the run. Offline code:
+// record() allocates as the samples grow (reserve() ahead), stats() sorts a copy.
 class LatencySamples {
  public:
-  void reserve(std::size_t n) { samples_.reserve(n); }
-  void record(std::int64_t ns) { samples_.push_back(ns < 0 ? 0 : ns); }
-  std::uint64_t count() const noexcept { return samples_.size(); }
+  static constexpr std::size_t kDefaultMaxExact = std::size_t{1} << 20;
+  explicit LatencySamples(std::size_t max_exact = kDefaultMaxExact);
+  ~LatencySamples();
+  LatencySamples(LatencySamples&&) noexcept;
+  LatencySamples& operator=(LatencySamples&&) noexcept;
+
+  void reserve(std::size_t n);
+  void record(std::int64_t ns);
+  std::uint64_t count() const noexcept;
+  // Whether stats() are the exact values (count() <= max_exact).
+  bool exact() const noexcept { return count() <= max_exact_; }
   LatencyStats stats() const;
 
  private:
-  std::vector<std::int64_t> samples_;
+  std::size_t max_exact_;
+  std::vector<std::int64_t> samples_;            // the first max_exact_
+  std::unique_ptr<LatencyHistogram> histogram_;  // every sample
 };
 
 class LatencyHistogram {

@@ -225,7 +225,10 @@ std::string format_track_summary(const OfflineTrackResult& r) {
         {"identify", &r.stats->identify},
         {"angles", &r.stats->angles},
         {"frame", &r.stats->frame}};
-    s += "  latency per frame (us):       p50        p99        max\n";
+    s += r.stats->frame.exact()
+             ? "  latency per frame (us):       p50        p99        max\n"
+             : "  latency per frame (us, histogram percentiles: at most 1/64 above):\n"
+               "                               p50        p99        max\n";
     for (const auto& [name, rec] : stages) {
       const LatencyStats l = rec->stats();
       std::snprintf(buf, sizeof buf, "    %-12s %14.1f %10.1f %10.1f\n", name, l.p50_us, l.p99_us,

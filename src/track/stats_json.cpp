@@ -32,8 +32,10 @@ Counters collect_counters(const FrameProcessor& p) {
 std::string stats_to_json(const TrackStats& stats) {
   std::string out;
   char buf[256];
-  std::snprintf(buf, sizeof buf, "{\"frames\": %lld,\n \"stages\": {",
-                static_cast<long long>(stats.frames));
+  // "percentiles": "exact" (nearest rank over every frame) or "histogram" (a run longer
+  // than LatencySamples keeps: at most 1/64 above).
+  std::snprintf(buf, sizeof buf, "{\"frames\": %lld,\n \"percentiles\": \"%s\",\n \"stages\": {",
+                static_cast<long long>(stats.frames), stats.frame.exact() ? "exact" : "histogram");
   out += buf;
   const std::pair<const char*, const LatencySamples*> stages[] = {
       {"load", &stats.load},         {"detect", &stats.detect}, {"triangulate", &stats.triangulate},

@@ -14,8 +14,8 @@
 
 namespace mocap {
 
-// The stages' times, every frame's kept (core/latency_histogram.h: LatencySamples, exact
-// nearest-rank percentiles; 48 bytes per frame).
+// The stages' times (core/latency_histogram.h: LatencySamples, exact nearest-rank
+// percentiles up to 2^20 frames, 48 bytes per frame; histogram percentiles beyond).
 struct TrackStats {
   void reserve(std::size_t frame_count) {
     for (LatencySamples* s : {&load, &detect, &triangulate, &identify, &angles, &frame})

@@ -2,7 +2,8 @@
 // it, buckets at most 1/64 wide), percentiles against exact nearest-rank percentiles of
 // random samples (never below, at most 1/64 above), interval snapshots, and a reader
 // thread running while the writer records (TSan: no race, monotone counts); the offline
-// LatencySamples' percentiles are the exact nearest-rank values.
+// LatencySamples' percentiles are the exact nearest-rank values up to its bound, the
+// histogram's beyond it.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -117,6 +118,42 @@ TEST(LatencySamples, PercentilesAreTheExactNearestRankValues) {
   LatencySamples negative;
   negative.record(-5);
   EXPECT_DOUBLE_EQ(negative.stats().max_us, 0.0);
+}
+
+TEST(LatencySamples, BeyondItsBoundTheHistogramAnswersAndTheMemoryStaysBounded) {
+  std::mt19937_64 rng(29);
+  std::lognormal_distribution<double> dist(13.0, 0.6);
+  constexpr std::size_t kBound = 1000;
+  LatencySamples samples(kBound);
+  H h;
+  std::vector<std::int64_t> v;
+  for (std::size_t i = 0; i < 5 * kBound; ++i) {
+    v.push_back(static_cast<std::int64_t>(dist(rng)));
+    samples.record(v.back());
+    h.record(v.back());
+    // Exact up to the bound, the histogram's values past it.
+    if (i + 1 == kBound) {
+      EXPECT_TRUE(samples.exact());
+      std::vector<std::int64_t> sorted = v;
+      std::sort(sorted.begin(), sorted.end());
+      EXPECT_DOUBLE_EQ(samples.stats().p99_us, static_cast<double>(sorted[989]) * 1e-3);
+    }
+  }
+  EXPECT_FALSE(samples.exact());
+  const LatencyStats s = samples.stats(), expected = h.stats();
+  EXPECT_EQ(s.count, 5 * kBound);
+  EXPECT_DOUBLE_EQ(s.p50_us, expected.p50_us);
+  EXPECT_DOUBLE_EQ(s.p99_us, expected.p99_us);
+  EXPECT_DOUBLE_EQ(s.max_us, expected.max_us);
+  // ...which bound the exact values of all 5000 samples from above by at most 1/64.
+  std::sort(v.begin(), v.end());
+  EXPECT_GE(s.p99_us, static_cast<double>(v[4949]) * 1e-3 - 1e-9);
+  EXPECT_LE(s.p99_us, static_cast<double>(v[4949]) * 1e-3 * (1.0 + 1.0 / 64.0) + 1e-3);
+  // A reserve beyond the bound reserves the bound.
+  LatencySamples reserved(kBound);
+  reserved.reserve(1'000'000'000);
+  EXPECT_EQ(reserved.count(), 0u);
+  EXPECT_TRUE(reserved.exact());
 }
 
 TEST(LatencyHistogram, IntervalSnapshotHoldsOnlyTheNewSamples) {
