@@ -37,7 +37,9 @@ class Doorbell {
     }
   }
 
-  // Consumer: sleeps until ring() after `seen` was taken, or timeout_ns passed.
+  // Consumer: sleeps until ring() after `seen` was taken, or timeout_ns passed. It may
+  // also return early with the count unchanged (the futex wake-up of a ring that found
+  // this consumer awake, delayed until it waited again): callers re-check their input.
   void wait(std::uint32_t seen, std::int64_t timeout_ns) noexcept {
     waiters_.fetch_add(1, std::memory_order_seq_cst);
     if (count_.load(std::memory_order_seq_cst) == seen) {
