@@ -241,8 +241,6 @@ bool StereoTriangulator::process(const UndistortedBlobs& a, const UndistortedBlo
     counters_.points_overflow[1] += static_cast<std::uint64_t>(r_b - n_b);
     frame_overflow_ = true;
   }
-  n_a_ = n_a;
-  n_b_ = n_b;
   prepare(b, n_b, 1, obs_b_);
   std::fill_n(use_a_.begin(), n_a, std::uint16_t{0});
   std::fill_n(use_b_.begin(), n_b, std::uint16_t{0});
@@ -268,7 +266,6 @@ bool StereoTriangulator::process(const UndistortedBlobs& a, const UndistortedBlo
       const Observation& o = obs_b_[static_cast<std::size_t>(j)];
       if (o.valid) keys_b_[static_cast<std::size_t>(k++)] = SortKey{o.key, j};
     }
-    n_b_ = k;
     std::sort(keys_b_.begin(), keys_b_.begin() + k,
               [](const SortKey& x, const SortKey& y) { return x.key < y.key; });
     // The settled a-blobs search the unsettled b-blobs' keys (in the same order).

@@ -162,8 +162,6 @@ class StereoTriangulator {
   std::vector<std::uint16_t> use_a_;
   std::vector<std::uint16_t> use_b_;
   SettledBlobs settled_;  // this frame's (process())
-  int n_a_ = 0;
-  int n_b_ = 0;
   bool frame_overflow_ = false;
   StereoCounters counters_;
 };
