@@ -76,6 +76,7 @@ void DetectStage::pass(const hal::Frame& f) noexcept {
   const std::int64_t t0 = monotonic_ns();
   BlobSlot& slot = out_[h];
   slot.blobs.clear();
+  slot.undistorted.received = -1;
   slot.present = !f.missing && (!f.image.empty() || f.blobs != nullptr);
   if (slot.present && f.blobs != nullptr) {  // a camera node detected them: pass through
     for (const detect::Blob& b : *f.blobs) slot.blobs.push_back(b);  // capacity: counted
@@ -83,6 +84,10 @@ void DetectStage::pass(const hal::Frame& f) noexcept {
     library_.blobs.add(slot.blobs.size());
   } else if (slot.present) {
     processor_.detect_camera(camera_, f.image, slot.blobs);
+    // Stage 2's first step here, in parallel with the other cameras' stages, off the
+    // identify stage (FrameProcessor::undistort_camera). Not for a camera node's blobs:
+    // those pass through on the capture thread, which keeps to its triggers.
+    processor_.undistort_camera(camera_, slot.blobs, slot.undistorted);
     library_.blobs.add(slot.blobs.size());
     library_.detector.publish(kDetectorFields, processor_.detector_counters(camera_));
   }

@@ -24,9 +24,14 @@ Expected<std::unique_ptr<IdentifyStage>> IdentifyStage::create(std::uint32_t inp
       new IdentifyStage(context, processor, out, std::move(pairer).value()));
   for (int c = 0; c < s->cameras_; ++c) {
     const detect::BlobList proto = s->frame_->blobs[static_cast<std::size_t>(c)];
+    const UndistortedStore proto_undistorted =
+        static_cast<std::size_t>(c) < s->frame_->undistorted.size()
+            ? s->frame_->undistorted[static_cast<std::size_t>(c)]
+            : UndistortedStore{};
     auto pool = rt::SlotPool<BlobSlot>::create(input_depth + 2, [&](std::uint32_t) {
       BlobSlot slot;
-      slot.blobs = proto;  // the detector's capacity: no allocation when filled
+      slot.blobs = proto;                    // the detector's capacity: no allocation when filled
+      slot.undistorted = proto_undistorted;  // the same, for the detect stage's undistortion
       return slot;
     });
     if (!pool) return pool.error();
@@ -151,6 +156,7 @@ void IdentifyStage::process(const hal::FramePair& set) noexcept {
     }
     BlobSlot& slot = (*inputs_[ci])[set.cam[c].handle];
     std::swap(out.blobs[ci], slot.blobs);  // O(1), same capacities: no allocation
+    if (ci < out.undistorted.size()) std::swap(out.undistorted[ci], slot.undistorted);
     out.camera_present[ci] = slot.present;
   }
   const int f = first_present(set);

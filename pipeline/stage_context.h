@@ -19,6 +19,7 @@
 #include "pipeline/publish/frame_result.h"
 #include "pipeline/stage_table.h"
 #include "rt/doorbell.h"
+#include "stereo/undistorted_blobs.h"
 
 namespace mocap::pipeline {
 
@@ -27,6 +28,7 @@ inline constexpr std::int64_t kIdleWaitNs = 10'000'000;
 
 struct BlobSlot {
   detect::BlobList blobs;
+  UndistortedStore undistorted;  // the blobs undistorted by the detect stage (received < 0: not)
   std::uint64_t sequence = 0;
   std::int64_t capture_ns = 0;  // the data's capture time (hal::Frame::timestamp_ns)
   std::int64_t origin_ns = 0;   // where its latencies start (hal::latency_origin_ns)

@@ -26,11 +26,20 @@ UndistortedBlobs BlobUndistorter::undistort(const Vec2* px, int n) noexcept {
   v.count = std::min(n, capacity());
   for (int i = 0; i < v.count; ++i) {
     const auto k = static_cast<std::size_t>(i);
-    const Vec2& p = px[i];
-    valid_[k] =
-        std::isfinite(p.x()) && std::isfinite(p.y()) && undistort_pixel(camera_, p, xn_[k]) ? 1 : 0;
+    valid_[k] = undistort_one(px[i], xn_[k]);
   }
   return v;
+}
+
+std::uint8_t BlobUndistorter::undistort_one(const Vec2& p, Vec2& xn) const noexcept {
+  return std::isfinite(p.x()) && std::isfinite(p.y()) && undistort_pixel(camera_, p, xn) ? 1 : 0;
+}
+
+UndistortedStore BlobUndistorter::make_store() const {
+  UndistortedStore s;
+  s.xn.assign(xn_.size(), Vec2::Zero());
+  s.valid.assign(valid_.size(), 0);
+  return s;
 }
 
 }  // namespace mocap

@@ -31,7 +31,12 @@ void ParallelDetect::detect_claimed(std::uint32_t gen) noexcept {
     const ImageView* view = uc < views_.size() ? views_[uc] : nullptr;
     out_->blobs[uc].clear();
     out_->camera_present[uc] = view != nullptr;
-    if (view != nullptr) proc_.detect_camera(static_cast<int>(uc), *view, out_->blobs[uc]);
+    if (view != nullptr) {
+      proc_.detect_camera(static_cast<int>(uc), *view, out_->blobs[uc]);
+      // Stage 2's first step too, on this thread (FrameProcessor::undistort_camera).
+      if (uc < out_->undistorted.size())
+        proc_.undistort_camera(static_cast<int>(uc), out_->blobs[uc], out_->undistorted[uc]);
+    }
     // release: the caller's acquire load of completed_ sees this camera's blob list.
     if (completed_.fetch_add(1, std::memory_order_release) + 1 == n) done_.ring();
     v = next_.load(std::memory_order_relaxed);

@@ -6,7 +6,9 @@
 // delaying the frame; the frame's other stages (correspondence, triangulation,
 // identification, angles) then run on the calling thread. The output is exactly
 // FrameProcessor::process's: every camera has its own detector and blob list, and
-// detect_camera() is thread-safe between different cameras.
+// detect_camera() is thread-safe between different cameras. The thread that detects a
+// camera also undistorts its blobs (FrameProcessor::undistort_camera, stage 2's first
+// step, bit for bit), so the calling thread's stage 2 starts from them.
 // Per frame: the caller rings posted_ (rt::Doorbell: a futex with a timeout, no lock),
 // then publishes the frame and a generation-tagged camera counter
 // (next_: generation << 32 | next camera); each thread claims a camera by compare-exchange

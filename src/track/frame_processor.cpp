@@ -133,7 +133,23 @@ FrameOutput FrameProcessor::make_output() const {
   out.poses.count = identifier_.body_count();
   if (angles_) out.angles = angles_->make_output();
   out.body_rates = body_motion_->make_output();
+  for (const BlobUndistorter& u : undistorters_) out.undistorted.push_back(u.make_store());
   return out;
+}
+
+void FrameProcessor::undistort_camera(int camera, const detect::BlobList& blobs,
+                                      UndistortedStore& out) const noexcept {
+  out.received = -1;
+  if (camera < 0 || static_cast<std::size_t>(camera) >= undistorters_.size()) return;
+  // The blobs triangulate() takes: the first max_points_per_camera.
+  const auto uc = static_cast<std::size_t>(camera);
+  const int n = static_cast<int>(std::min(blobs.size(), centroids_px_[uc].size()));
+  undistorters_[uc].undistort_into(
+      [&](int i) noexcept {
+        const detect::Blob& b = blobs[static_cast<std::size_t>(i)];
+        return Vec2(b.x_px, b.y_px);
+      },
+      n, out);
 }
 
 bool FrameProcessor::detect_camera(int camera, const ImageView& image,
@@ -159,6 +175,12 @@ bool FrameProcessor::process(std::span<const ImageView* const> views, std::int64
 }
 
 void FrameProcessor::triangulate(FrameOutput& out) noexcept {
+  triangulate_points(out);
+  // Consumed: the next frame's are made anew by its detection (or here).
+  for (UndistortedStore& u : out.undistorted) u.received = -1;
+}
+
+void FrameProcessor::triangulate_points(FrameOutput& out) noexcept {
   out.points.clear();
   const int n_cams = camera_count();
   const Vec2* px[kMaxCameras] = {};
@@ -182,11 +204,16 @@ void FrameProcessor::triangulate(FrameOutput& out) noexcept {
     return;
   }
   // Each camera's blobs undistorted once, for all its pairs (the same result as each
-  // pair undistorting them).
+  // pair undistorting them): where they were detected, when that thread did it.
   UndistortedBlobs views[kMaxCameras];
-  for (int c = 0; c < n_cams; ++c)
-    if (out.camera_present[static_cast<std::size_t>(c)])
-      views[c] = undistorters_[static_cast<std::size_t>(c)].undistort(px[c], n[c]);
+  for (int c = 0; c < n_cams; ++c) {
+    const auto uc = static_cast<std::size_t>(c);
+    if (!out.camera_present[uc]) continue;
+    if (uc < out.undistorted.size() && out.undistorted[uc].received == n[c])
+      views[c] = out.undistorted[uc].view(px[c]);
+    else
+      views[c] = undistorters_[uc].undistort(px[c], n[c]);
+  }
   // Pair by pair into the merge: a pair of blobs that earlier pairs settled (both in
   // points seen by three or more cameras) is not triangulated again.
   merger_.begin_frame(px, n);

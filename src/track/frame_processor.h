@@ -34,6 +34,7 @@
 #include "kinematics/joint_rates.h"
 #include "stereo/multiview.h"
 #include "stereo/stereo_triangulator.h"
+#include "stereo/undistorted_blobs.h"
 #include "track/body_motion.h"
 #include "track/chain_solver.h"
 #include "track/marker_shape.h"
@@ -87,6 +88,10 @@ struct StageTimesNs {
 struct FrameOutput {
   std::vector<detect::BlobList> blobs;             // one per camera of the rig
   std::array<bool, kMaxCameras> camera_present{};  // false: the camera's frame was missing
+  // Per camera (3+ cameras): its blobs undistorted where they were detected
+  // (FrameProcessor::undistort_camera), which stage 2 then takes instead of undistorting
+  // them itself; received < 0: none. Stage 2 marks them consumed.
+  std::vector<UndistortedStore> undistorted;
   PointList points;
   BodyPoses poses;
   kinematics::JointAngles angles;
@@ -111,6 +116,12 @@ class FrameProcessor {
   bool detect_camera(int camera, const ImageView& image, detect::BlobList& out) noexcept;
   // Stages 2-4 on the blobs already in `out.blobs` (camera_present must be set).
   bool process_blobs(std::int64_t timestamp_ns, FrameOutput& out) noexcept;
+  // Stage 2's first step for one camera, where its blobs were detected (thread-safe
+  // between different cameras): their undistortion into `out` (FrameOutput::undistorted
+  // of that camera, or a store handed on with the blobs), bit for bit what stage 2 would
+  // compute; it moves that work off the thread of stages 2-4. 2 cameras: nothing (none).
+  void undistort_camera(int camera, const detect::BlobList& blobs,
+                        UndistortedStore& out) const noexcept;
 
   // Forget temporal state (identification priors, hinge unwrapping, joint and body rates).
   void reset() noexcept;
@@ -157,6 +168,7 @@ class FrameProcessor {
                  std::optional<kinematics::JointAngleSolver> angles);
   // Stereo and N-view merge into out.points from out.blobs and out.camera_present.
   void triangulate(FrameOutput& out) noexcept;
+  void triangulate_points(FrameOutput& out) noexcept;
   // Marks the identification's input; drops unfit views of points seen by 3+ cameras.
   void measure_points(FrameOutput& out) noexcept;
   // Chain tracking after identification: chain-solved bodies join out.poses.

@@ -1,5 +1,6 @@
 // Tests of the FrameProcessor: steady-state processing allocates nothing, a missing
-// camera frame yields no 3D points, damaged images never crash.
+// camera frame yields no 3D points, damaged images never crash, every point is emitted
+// once, and stage 2's undistortion made where the blobs were detected changes nothing.
 #include <gtest/gtest.h>
 
 #include <array>
@@ -155,6 +156,68 @@ TEST(FrameProcessor, FourCamerasEmitEveryPointOnce) {
   }
   EXPECT_EQ(duplicated_frames, 0);
   EXPECT_EQ(proc->multiview_counters().frames, 60u);
+}
+
+// Stage 2's undistortion made where the blobs were detected (undistort_camera, as the
+// detect threads do) gives stage 2 exactly the points it computes itself, and it is what
+// stage 2 takes (a damaged store changes the points); a store made for other blobs
+// (another count) is not taken; stage 2 marks every store consumed; a 2-camera processor
+// has none to make.
+TEST(FrameProcessor, UndistortionMadeWhereTheBlobsWereDetectedGivesTheSamePoints) {
+  sim::SimOptions o;
+  o.scene = sim::SceneKind::kLimbs;
+  o.cameras = 4;
+  o.frames = 10;
+  o.stray = 3;
+  const std::string& dir = test::simulated_recording("limbs4_undistort", o);
+  auto rec = Recording::open(dir);
+  ASSERT_TRUE(rec.ok());
+  auto targets = load_targets(dir + "/targets.yaml");
+  ASSERT_TRUE(targets.ok());
+  auto here = FrameProcessor::create(rec->rig(), *targets, nullptr, TrackerConfig{});
+  auto there = FrameProcessor::create(rec->rig(), *targets, nullptr, TrackerConfig{});
+  ASSERT_TRUE(here.ok() && there.ok());
+  FrameOutput a = here->make_output(), b = there->make_output();
+  ASSERT_EQ(b.undistorted.size(), 4u);
+  FrameSetLoader loader(*rec);
+  int points = 0;
+  for (const FrameEntry& f : rec->frames()) {
+    loader.load(f.frame);
+    here->process(loader.views(), f.timestamp_ns, a);
+    for (int c = 0; c < 4; ++c) {
+      const auto uc = static_cast<std::size_t>(c);
+      b.blobs[uc].clear();
+      b.camera_present[uc] = true;
+      ASSERT_TRUE(there->detect_camera(c, *loader.views()[uc], b.blobs[uc]));
+      there->undistort_camera(c, b.blobs[uc], b.undistorted[uc]);
+      ASSERT_EQ(b.undistorted[uc].received, static_cast<int>(b.blobs[uc].size()));
+    }
+    // Frames 1, 4, 7: camera 1's store, damaged, claims one blob more (made for other
+    // blobs: not taken). Frames 2, 5, 8: damaged only (taken: other points).
+    const bool damaged = f.frame % 3 != 0, foreign = f.frame % 3 == 1;
+    if (damaged)
+      for (Vec2& xn : b.undistorted[1].xn) xn += Vec2(1e-3, 0.0);
+    if (foreign) ++b.undistorted[1].received;
+    there->process_blobs(f.timestamp_ns, b);
+    for (const UndistortedStore& u : b.undistorted) EXPECT_EQ(u.received, -1);
+    bool same = a.points.size() == b.points.size();
+    for (int i = 0; same && i < a.points.size(); ++i)
+      same = a.points[i].X_world == b.points[i].X_world &&
+             a.points[i].blob_index == b.points[i].blob_index;
+    EXPECT_EQ(same, !damaged || foreign) << "frame " << f.frame;
+    points += a.points.size();
+  }
+  EXPECT_GT(points, 100);
+  // Two cameras: the pair undistorts its blobs itself; no store is made.
+  const std::string& dir2 = test::simulated_recording("alloc", small_options());
+  Loaded l = load(dir2);
+  auto pair = FrameProcessor::create(l.rec.rig(), l.targets, nullptr, TrackerConfig{});
+  ASSERT_TRUE(pair.ok());
+  FrameOutput p = pair->make_output();
+  EXPECT_TRUE(p.undistorted.empty());
+  UndistortedStore none = a.undistorted.front();
+  pair->undistort_camera(0, p.blobs[0], none);
+  EXPECT_EQ(none.received, -1);
 }
 
 }  // namespace
