@@ -21,6 +21,16 @@ sim::SimOptions small_options() {
   return o;
 }
 
+// 60 frames of the limbs scene on a 4-camera arc, 3 strays per camera (rendered once).
+const std::string& limbs4_recording() {
+  sim::SimOptions o;
+  o.scene = sim::SceneKind::kLimbs;
+  o.cameras = 4;
+  o.frames = 60;
+  o.stray = 3;
+  return test::simulated_recording("limbs4", o);
+}
+
 struct Loaded {
   Recording rec;
   TargetSet targets;
@@ -130,12 +140,7 @@ TEST(FrameProcessor, DamagedImagesNeverCrash) {
 // hypothesis made of exactly the views it kept; the two copies were rivals, and the
 // upper arm was lost in that frame (frame 53 of this recording).
 TEST(FrameProcessor, FourCamerasEmitEveryPointOnce) {
-  sim::SimOptions o;
-  o.scene = sim::SceneKind::kLimbs;
-  o.cameras = 4;
-  o.frames = 60;
-  o.stray = 3;
-  const std::string& dir = test::simulated_recording("limbs4", o);
+  const std::string& dir = limbs4_recording();
   auto rec = Recording::open(dir);
   ASSERT_TRUE(rec.ok());
   auto targets = load_targets(dir + "/targets.yaml");
@@ -164,12 +169,7 @@ TEST(FrameProcessor, FourCamerasEmitEveryPointOnce) {
 // (another count) is not taken; stage 2 marks every store consumed; a 2-camera processor
 // has none to make.
 TEST(FrameProcessor, UndistortionMadeWhereTheBlobsWereDetectedGivesTheSamePoints) {
-  sim::SimOptions o;
-  o.scene = sim::SceneKind::kLimbs;
-  o.cameras = 4;
-  o.frames = 10;
-  o.stray = 3;
-  const std::string& dir = test::simulated_recording("limbs4_undistort", o);
+  const std::string& dir = limbs4_recording();
   auto rec = Recording::open(dir);
   ASSERT_TRUE(rec.ok());
   auto targets = load_targets(dir + "/targets.yaml");
