@@ -101,13 +101,14 @@ TEST(PipelineFaults, StalledCameraIsReportedAndDoesNotBlockTheOther) {
   EXPECT_GE(counter(st, "camera_max_silence_us_cam1"), 250'000u) << report;
   EXPECT_GT(counter(st, "dequeue_timeouts_cam1"), 0u) << report;
   EXPECT_LT(counter(st, "camera_max_silence_us_cam0"), counter(st, "camera_max_silence_us_cam1"));
-  // Frames of the stall were lost, the tracker published again after it, and the run
-  // ended with every frame published or counted as lost (the last set too: a frame that
-  // came late is taken, one a loaded machine dropped is counted).
+  // Frames of the stall were lost, the tracker published again after it (after frame
+  // 40 + 60 stalled dequeues; how many of the last frames a loaded machine drops, e.g.
+  // under TSan, is not the point: they are counted), and the run ended with every frame
+  // published or counted as lost (the last set too: a frame that came late is taken).
   EXPECT_GT(counter(st, "frames_dropped"), 0u) << report;
   EXPECT_TRUE((*p)->finished()) << report;
   ASSERT_GT(record.count(), 0u);
-  EXPECT_GE(record[record.count() - 1].sequence, 150u) << report;
+  EXPECT_GT(record[record.count() - 1].sequence, 100u) << report;
   EXPECT_EQ(st.triggered, st.published + counter(st, "frames_dropped")) << report;
 }
 
