@@ -8,14 +8,18 @@
 #pragma once
 
 #include <gtest/gtest.h>
+#include <signal.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "client/datagram.h"
@@ -32,22 +36,49 @@ struct Published {
   int datagrams = 0;
 };
 
-// The datagrams received so far on sock.
-inline Published drain(const KeepAllUdpSocket& sock) {
-  Published p;
+// Adds one datagram (n bytes of buf) to p when it decodes.
+inline void add_datagram(const std::uint8_t* buf, ssize_t n, Published& p) {
+  client::JointsMessage m;
+  if (n <= 0 ||
+      client::decode_datagram(buf, static_cast<std::size_t>(n), m) != client::DecodeStatus::kOk)
+    return;
+  ++p.datagrams;
+  std::vector<float>& a = p.angles[m.capture_ns];
+  for (int j = 0; j < m.joint_count; ++j)
+    for (float v : m.joints[j].a) a.push_back(m.joints[j].valid ? v : NAN);
+}
+
+// Adds the datagrams received on sock to p until none comes within the socket's timeout.
+inline void drain_into(const KeepAllUdpSocket& sock, Published& p) {
   std::uint8_t buf[client::kMaxDatagramBytes + 16];
   for (;;) {
     const ssize_t n = sock.receive(buf, sizeof buf);
     if (n <= 0) break;
-    client::JointsMessage m;
-    if (client::decode_datagram(buf, static_cast<std::size_t>(n), m) != client::DecodeStatus::kOk)
-      continue;
-    ++p.datagrams;
-    std::vector<float>& a = p.angles[m.capture_ns];
-    for (int j = 0; j < m.joint_count; ++j)
-      for (float v : m.joints[j].a) a.push_back(m.joints[j].valid ? v : NAN);
+    add_datagram(buf, n, p);
   }
+}
+
+// The datagrams received so far on sock.
+inline Published drain(const KeepAllUdpSocket& sock) {
+  Published p;
+  drain_into(sock, p);
   return p;
+}
+
+// Adds the datagrams received on sock to p until it holds `datagrams` of them (true) or
+// timeout_s passed (false): the event a cluster test waits for, instead of a wall-clock
+// guess at how fast the processes start and run on a loaded machine.
+inline bool receive_until(const KeepAllUdpSocket& sock, Published& p, int datagrams,
+                          double timeout_s) {
+  std::uint8_t buf[client::kMaxDatagramBytes + 16];
+  const auto deadline = std::chrono::steady_clock::now() +
+                        std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                            std::chrono::duration<double>(timeout_s));
+  while (p.datagrams < datagrams) {
+    if (std::chrono::steady_clock::now() > deadline) return false;
+    add_datagram(buf, sock.receive(buf, sizeof buf), p);
+  }
+  return true;
 }
 
 // Every frame of ref published in got, with the same valid joints and angles within
@@ -147,31 +178,42 @@ struct Cluster {
     return run_mocap("run --config '" + dir + "/single.yaml' --stats-interval 0", 120);
   }
 
-  // Both nodes in the background, the central `mocap <central_args>` in the foreground,
-  // all in dir (the central under a 120 s bound). kill_after_s > 0 SIGKILLs node 1 that
-  // long after the nodes started; restart_after_s > 0 starts it again that much later (for
-  // 20 s, its log in node1b.log). The output: the central's log, node 0's, then node 1's
-  // (the restarted one's when node 1 was killed).
-  RunResult run(const std::string& central_args, double kill_after_s = 0.0,
-                double restart_after_s = 0.0) const {
+  // Both nodes in the background (node 1's pid in node1.pid), the central `mocap
+  // <central_args>` in the foreground, all in dir (the central under a 120 s bound), on a
+  // thread of their own while `during` runs on the caller's: it may kill_node1() and
+  // restart_node1() when the events it waits for came. The output: the central's log,
+  // node 0's, then node 1's (the restarted one's when node 1 was restarted).
+  RunResult run(
+      const std::string& central_args, const std::function<void()>& during = [] {}) const {
     const std::string m = mocap_binary();
-    std::string cmd = "cd '" + dir + "' && { " + m +
-                      " node --config node0.yaml --duration 120 > node0.log 2>&1 & " + m +
-                      " node --config node1.yaml --duration 120 > node1.log 2>&1 & B=$!; }; ";
-    if (kill_after_s > 0) {
-      cmd += "(sleep " + std::to_string(kill_after_s) + "; kill -9 $B";
-      if (restart_after_s > 0)
-        cmd += "; sleep " + std::to_string(restart_after_s) + "; { " + m +
-               " node --config node1.yaml --duration 20 > node1b.log 2>&1 & echo $! > "
-               "node1b.pid; }";
-      cmd += ") & ";
-    }
-    cmd += "timeout 120 " + m + " " + central_args +
-           " > central.log 2>&1; rc=$?; wait; [ -f node1b.pid ] && kill $(cat node1b.pid); "
-           "sleep 0.5; cat central.log node0.log; " +
-           (kill_after_s > 0 ? "[ -f node1b.log ] && cat node1b.log; " : "cat node1.log; ") +
-           "exit $rc";
-    return run_command(cmd);
+    const std::string cmd =
+        "cd '" + dir + "' && { " + m +
+        " node --config node0.yaml --duration 120 > node0.log 2>&1 & " + m +
+        " node --config node1.yaml --duration 120 > node1.log 2>&1 & echo $! > node1.pid; }; " +
+        "timeout 120 " + m + " " + central_args +
+        " > central.log 2>&1; rc=$?; [ -f node1b.pid ] && kill $(cat node1b.pid); wait; "
+        "sleep 0.5; cat central.log node0.log; "
+        "if [ -f node1b.log ]; then cat node1b.log; else cat node1.log; fi; exit $rc";
+    RunResult r;
+    std::thread central([&] { r = run_command(cmd); });
+    during();
+    central.join();
+    // A restart that came after the central ended (its wait timed out) ends here too.
+    run_command("[ -f '" + dir + "/node1b.pid' ] && kill $(cat '" + dir +
+                "/node1b.pid') 2>/dev/null");
+    return r;
+  }
+  // SIGKILLs node 1 (started by run()).
+  void kill_node1() const {
+    const std::string pid = read_file(dir + "/node1.pid");
+    ASSERT_FALSE(pid.empty()) << dir << "/node1.pid";
+    ::kill(static_cast<pid_t>(std::stol(pid)), SIGKILL);
+  }
+  // Starts node 1 again (for at most 20 s; its log in node1b.log, its pid in node1b.pid).
+  void restart_node1() const {
+    run_command("cd '" + dir + "' && { " + mocap_binary() +
+                " node --config node1.yaml --duration 20 > node1b.log 2>&1 & echo $! > "
+                "node1b.pid; }");
   }
 
   // The central's `mocap record --blobs ... --out blobrec` (its run r) wrote every one of
