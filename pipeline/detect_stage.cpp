@@ -81,15 +81,17 @@ void DetectStage::pass(const hal::Frame& f) noexcept {
   if (slot.present && f.blobs != nullptr) {  // a camera node detected them: pass through
     for (const detect::Blob& b : *f.blobs) slot.blobs.push_back(b);  // capacity: counted
     slot.blobs.set_levels(f.blobs->levels());
-    library_.blobs.add(slot.blobs.size());
   } else if (slot.present) {
     processor_.detect_camera(camera_, f.image, slot.blobs);
-    // Stage 2's first step here, in parallel with the other cameras' stages, off the
-    // identify stage (FrameProcessor::undistort_camera). Not for a camera node's blobs:
-    // those pass through on the capture thread, which keeps to its triggers.
+    library_.detector.publish(kDetectorFields, processor_.detector_counters(camera_));
+  }
+  if (slot.present) {
+    // Stage 2's first step here, off the identify stage (FrameProcessor::undistort_camera):
+    // on this camera's detect thread, in parallel with the other cameras'; for a camera
+    // node's blobs on the capture thread (a few us per camera), while it waits for the
+    // set's other cameras.
     processor_.undistort_camera(camera_, slot.blobs, slot.undistorted);
     library_.blobs.add(slot.blobs.size());
-    library_.detector.publish(kDetectorFields, processor_.detector_counters(camera_));
   }
   if (BlobTap* const tap = context_.options().blob_tap; tap != nullptr)
     tap->on_blobs(camera_, f, slot.present, slot.blobs);

@@ -10,6 +10,8 @@
 // camera's stage (hal::Camera::delivers_blobs) has no thread: the capture thread hands each
 // frame through pass() (the one producer of its blob slots, the only writer of its
 // counters), which saves a thread's wake-up between the blobs' arrival and identify.
+// Either way pass() undistorts the slot's blobs for identify (FrameProcessor::
+// undistort_camera), on this camera's detect thread or on the capture thread.
 // Drop policy: it works on the NEWEST frame and returns the older ones (detect#_skipped);
 // when identify holds every blob slot the frame is dropped (detect#_no_slot). With
 // options.every_frame (`mocap record --blobs`, `pipeline.every_frame`) it detects every frame in

@@ -111,6 +111,10 @@ struct MultiViewCounters {
   std::uint64_t point_overflow = 0;       // emitted points beyond the output's capacity
   std::uint64_t blob_overflow = 0;        // blobs beyond max_points_per_camera (ignored)
   std::uint64_t settled = 0;              // candidates of two settled blobs (no hypothesis)
+  // Camera frames whose blobs came without their undistortion (an UndistortedStore made
+  // where they were detected), so the triangulation made it: FrameProcessor's count, not
+  // the merger's (0 in the live pipeline and in `mocap track` on two threads).
+  std::uint64_t undistorted_late = 0;
 };
 
 class MultiViewMerger {

@@ -99,7 +99,7 @@ inline constexpr std::array<CounterField<StereoCounters>, 15> kStereoFields = {{
 }};
 
 // Reported as multiview_<name>, with three or more cameras.
-inline constexpr std::array<CounterField<MultiViewCounters>, 15> kMultiViewFields = {{
+inline constexpr std::array<CounterField<MultiViewCounters>, 16> kMultiViewFields = {{
     MOCAP_COUNTER_FIELD(MultiViewCounters, frames),
     MOCAP_COUNTER_FIELD(MultiViewCounters, hypotheses),
     MOCAP_COUNTER_FIELD(MultiViewCounters, hypothesis_overflow),
@@ -115,6 +115,7 @@ inline constexpr std::array<CounterField<MultiViewCounters>, 15> kMultiViewField
     MOCAP_COUNTER_FIELD(MultiViewCounters, point_overflow),
     MOCAP_COUNTER_FIELD(MultiViewCounters, blob_overflow),
     MOCAP_COUNTER_FIELD(MultiViewCounters, settled),
+    MOCAP_COUNTER_FIELD(MultiViewCounters, undistorted_late),
 }};
 
 // Reported as identify_<name>.

@@ -209,10 +209,12 @@ void FrameProcessor::triangulate_points(FrameOutput& out) noexcept {
   for (int c = 0; c < n_cams; ++c) {
     const auto uc = static_cast<std::size_t>(c);
     if (!out.camera_present[uc]) continue;
-    if (uc < out.undistorted.size() && out.undistorted[uc].received == n[c])
+    if (uc < out.undistorted.size() && out.undistorted[uc].received == n[c]) {
       views[c] = out.undistorted[uc].view(px[c]);
-    else
+    } else {
       views[c] = undistorters_[uc].undistort(px[c], n[c]);
+      ++undistorted_late_;
+    }
   }
   // Pair by pair into the merge: a pair of blobs that earlier pairs settled (both in
   // points seen by three or more cameras) is not triangulated again.
@@ -228,6 +230,8 @@ void FrameProcessor::triangulate_points(FrameOutput& out) noexcept {
     merger_.add_pair(pair_points_[k], px);
   }
   merger_.finish(px, out.points);
+  multiview_total_ = merger_.counters();
+  multiview_total_.undistorted_late = undistorted_late_;
   StereoCounters total;
   for (const StereoTriangulator& st : pairs_) total += st.counters();
   stereo_total_ = total;

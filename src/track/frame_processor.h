@@ -143,7 +143,9 @@ class FrameProcessor {
   // The pairwise stereo counters summed over the camera pairs (one pair: its own;
   // points_in[0] and [1] then sum each pair's first and second camera).
   const StereoCounters& stereo_counters() const noexcept { return stereo_total_; }
-  const MultiViewCounters& multiview_counters() const noexcept { return merger_.counters(); }
+  // The merger's counters and undistorted_late (the camera frames triangulate() undistorted
+  // itself), as of the last frame.
+  const MultiViewCounters& multiview_counters() const noexcept { return multiview_total_; }
   const IdentifyCounters& identify_counters() const noexcept { return identifier_.counters(); }
   // Joint-rate filter counters; null without a model.
   const kinematics::RateFilterCounters* rate_counters() const noexcept {
@@ -185,6 +187,8 @@ class FrameProcessor {
   std::vector<StereoTriangulator> pairs_;        // one per camera pair (a < b)
   MultiViewMerger merger_;
   StereoCounters stereo_total_;
+  MultiViewCounters multiview_total_;
+  std::uint64_t undistorted_late_ = 0;
   Identifier identifier_;
   std::optional<kinematics::JointAngleSolver> angles_;
   std::optional<ChainSolver> chain_;

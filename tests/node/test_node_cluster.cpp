@@ -110,6 +110,8 @@ TEST_F(NodeCluster, TwoNodesPublishEveryFrameWithTheSingleProcessAngles) {
   EXPECT_NE(r.output.find("the recording ended"), std::string::npos) << r.output;
   const Published got = drain(nodes_sock);
   EXPECT_EQ(got.datagrams, kFrames) << r.output;
+  // Every node camera's blobs came undistorted (by the capture thread that handed them on).
+  EXPECT_NE(r.output.find(" multiview_undistorted_late=0"), std::string::npos) << r.output;
   test::node_cluster::expect_same_angles(ref.angles, got.angles, 1e-5, kFrames, r.output);
 }
 

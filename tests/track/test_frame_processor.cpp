@@ -166,8 +166,8 @@ TEST(FrameProcessor, FourCamerasEmitEveryPointOnce) {
 // Stage 2's undistortion made where the blobs were detected (undistort_camera, as the
 // detect threads do) gives stage 2 exactly the points it computes itself, and it is what
 // stage 2 takes (a damaged store changes the points); a store made for other blobs
-// (another count) is not taken; stage 2 marks every store consumed; a 2-camera processor
-// has none to make.
+// (another count) is not taken and is counted (multiview_undistorted_late); stage 2 marks
+// every store consumed; a 2-camera processor has none to make.
 TEST(FrameProcessor, UndistortionMadeWhereTheBlobsWereDetectedGivesTheSamePoints) {
   const std::string& dir = limbs4_recording();
   auto rec = Recording::open(dir);
@@ -183,6 +183,7 @@ TEST(FrameProcessor, UndistortionMadeWhereTheBlobsWereDetectedGivesTheSamePoints
   int points = 0;
   for (const FrameEntry& f : rec->frames()) {
     loader.load(f.frame);
+    const std::uint64_t late_here = here->multiview_counters().undistorted_late;
     here->process(loader.views(), f.timestamp_ns, a);
     for (int c = 0; c < 4; ++c) {
       const auto uc = static_cast<std::size_t>(c);
@@ -198,8 +199,13 @@ TEST(FrameProcessor, UndistortionMadeWhereTheBlobsWereDetectedGivesTheSamePoints
     if (damaged)
       for (Vec2& xn : b.undistorted[1].xn) xn += Vec2(1e-3, 0.0);
     if (foreign) ++b.undistorted[1].received;
+    const std::uint64_t late = there->multiview_counters().undistorted_late;
     there->process_blobs(f.timestamp_ns, b);
     for (const UndistortedStore& u : b.undistorted) EXPECT_EQ(u.received, -1);
+    // Counted when not taken: camera 1's foreign store; and every camera here (process()
+    // detects and leaves the undistortion to stage 2).
+    EXPECT_EQ(there->multiview_counters().undistorted_late - late, foreign ? 1u : 0u);
+    EXPECT_EQ(here->multiview_counters().undistorted_late - late_here, 4u);
     bool same = a.points.size() == b.points.size();
     for (int i = 0; same && i < a.points.size(); ++i)
       same = a.points[i].X_world == b.points[i].X_world &&
