@@ -126,9 +126,12 @@ void FramePoints::build_pairs(double max2) noexcept {
     }
   }
   pair_count_ = c;
+  std::sort(pairs_.begin(), pairs_.begin() + c,
+            [](const PointPair& a, const PointPair& b) { return a.d_mm < b.d_mm; });
   for (int i = 0; i < n_; ++i)
     adj_start_[static_cast<std::size_t>(i) + 1] += adj_start_[static_cast<std::size_t>(i)];
-  // Fill with a moving cursor per point (adj_start_[i + 1] temporarily), then sort.
+  // Fill with a moving cursor per point (adj_start_[i + 1] temporarily) from the pairs in
+  // ascending distance: each point's neighbours come nearest first.
   for (int p = 0; p < c; ++p) {
     const PointPair& pp = pairs_[static_cast<std::size_t>(p)];
     adj_[static_cast<std::size_t>(adj_start_[static_cast<std::size_t>(pp.i)]++)] = pp.j;
@@ -137,14 +140,21 @@ void FramePoints::build_pairs(double max2) noexcept {
   for (int i = n_; i > 0; --i)
     adj_start_[static_cast<std::size_t>(i)] = adj_start_[static_cast<std::size_t>(i) - 1];
   adj_start_[0] = 0;
+  // Sorted by the squared distance itself, (X(j) - X(i)).squaredNorm(), the value a
+  // search compares (two squared distances may share a square root: the pairs' order
+  // can then swap them). Nearly sorted already: an insertion sort is linear here.
   for (int i = 0; i < n_; ++i) {
     std::int16_t* a = adj_.data() + adj_start_[static_cast<std::size_t>(i)];
     const int na = neighbour_count(i);
-    for (int x = 1; x < na; ++x)  // insertion sort: ascending index
-      for (int y = x; y > 0 && a[y - 1] > a[y]; --y) std::swap(a[y - 1], a[y]);
+    const auto d2 = [&](int j) noexcept { return (X(j) - X(i)).squaredNorm(); };
+    for (int x = 1; x < na; ++x) {
+      const std::int16_t v = a[x];
+      const double key = d2(v);
+      int y = x;
+      for (; y > 0 && d2(a[y - 1]) > key; --y) a[y] = a[y - 1];
+      a[y] = v;
+    }
   }
-  std::sort(pairs_.begin(), pairs_.begin() + c,
-            [](const PointPair& a, const PointPair& b) { return a.d_mm < b.d_mm; });
 }
 
 FramePoints::LoadStats FramePoints::load(const MeasuredPoint* pts, int n,

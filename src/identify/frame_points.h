@@ -1,7 +1,8 @@
 // Design: the per-frame view of the measured points shared by every target's search:
 // positions, the measured pair distances sorted ascending (only pairs short enough to
 // be any target's pair, and never two mutually exclusive points), each point's
-// neighbours (the points it forms such a pair with, ascending index), a uniform grid of
+// neighbours (the points it forms such a pair with, nearest first: a search for the
+// points at a given distance from it bisects the list), a uniform grid of
 // the points for radius queries (the temporal path's gates), and an occupancy state
 // (points and per-camera blobs in use) that the depth-first search and the multi-body
 // conflict resolution acquire and release. A point is available only when neither it
@@ -57,7 +58,8 @@ class FramePoints {
   // After prepare_pairs():
   const PointPair* pairs() const noexcept { return pairs_.data(); }
   int pair_count() const noexcept { return pair_count_; }
-  // The points forming a pair with i (within max_pair_mm, not exclusive), ascending.
+  // The points forming a pair with i (within max_pair_mm, not exclusive), in ascending
+  // (X(j) - X(i)).squaredNorm().
   const std::int16_t* neighbours(int i) const noexcept {
     return adj_.data() + adj_start_[static_cast<std::size_t>(i)];
   }

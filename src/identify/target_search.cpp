@@ -150,13 +150,26 @@ void TargetSearch::extend(int level, double sum_sq) noexcept {
   const double lo2 = d0 > t ? (d0 - t) * (d0 - t) : 0.0;
   const double hi2 = (d0 + t) * (d0 + t);
   // Candidates: the marker's gate (gated mode), else the neighbours of the first slot's
-  // point (every point closer than the longest pair + t; the others fail q2 < hi2).
-  const std::int16_t* cand =
-      gated_ != nullptr ? gated_->point[cs].data() : frame.neighbours(slot_point_[0]);
-  const int nc = gated_ != nullptr ? gated_->count[cs] : frame.neighbour_count(slot_point_[0]);
-  for (int e = 0; e < nc; ++e) {
+  // point (every point closer than the longest pair + t; the others fail q2 < hi2),
+  // nearest first: the band lo2 < q2 < hi2 starts where a bisection puts it and ends at
+  // the first point beyond it (the same points as testing all, in another order).
+  const bool gated = gated_ != nullptr;
+  const std::int16_t* cand = gated ? gated_->point[cs].data() : frame.neighbours(slot_point_[0]);
+  const int nc = gated ? gated_->count[cs] : frame.neighbour_count(slot_point_[0]);
+  int first = 0;
+  if (!gated) {
+    for (int hi = nc; first < hi;) {
+      const int mid = first + (hi - first) / 2;
+      if ((frame.X(cand[mid]) - X0).squaredNorm() <= lo2)
+        first = mid + 1;
+      else
+        hi = mid;
+    }
+  }
+  for (int e = first; e < nc; ++e) {
     const int p = cand[e];
     const double q2 = (frame.X(p) - X0).squaredNorm();
+    if (!gated && q2 >= hi2) break;
     if (q2 <= lo2 || q2 >= hi2 || !frame.available(p)) continue;
     bool ok = true;
     for (int s = 1; s < m_ && ok; ++s) {

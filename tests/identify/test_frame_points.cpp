@@ -3,9 +3,13 @@
 // available exactly when it is valid and neither it nor any point sharing a blob with it
 // is held, uses() is the acquisitions of the point and of the points sharing a blob with
 // it, each sharing point is a partner once (however many blobs the two share), and
-// release_all() and the next load() start from nothing.
+// release_all() and the next load() start from nothing. The pairs and each point's
+// neighbours against their definition: every two valid points no farther apart than the
+// bound and sharing no blob, the pairs in ascending distance, each point's neighbours
+// nearest first by the squared distance a search compares.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -87,6 +91,58 @@ TEST(FramePoints, OccupancyFollowsItsDefinitionUnderRandomAcquireAndRelease) {
   }
   EXPECT_GT(checks, 10000);
   EXPECT_GT(blocked_by_partner, 100) << "the frames share too few blobs to test anything";
+}
+
+TEST(FramePoints, ThePairsAndEachPointsNeighboursNearestFirstFollowTheirDefinition) {
+  std::mt19937_64 rng(12);
+  constexpr int kCameras = 4;
+  constexpr double kMaxPairMm = 300.0;
+  FramePoints frame(120, kCameras);
+  int neighbours = 0, ties = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    const int n = 20 + 2 * trial;
+    RandomFrame f = random_frame(rng, n, kCameras, 20 + trial);
+    // Some points on a lattice: many equal distances (and ties after the square root).
+    for (int i = 0; i < n; i += 3)
+      f.pts[static_cast<std::size_t>(i)].X_world =
+          Vec3(25.0 * (i % 7), 25.0 * (i % 5), 12.5 * (i % 3)) - Vec3(0.1 * trial, 0.0, 0.0);
+    frame.load(f.pts.data(), n, kMaxPairMm);
+    frame.prepare_pairs();
+    const auto X = [&](int i) -> const Vec3& { return f.pts[static_cast<std::size_t>(i)].X_world; };
+    const auto pairs_with = [&](int i, int j) {
+      return i != j && X(i).allFinite() && X(j).allFinite() &&
+             !f.pts[static_cast<std::size_t>(i)].blob_index.shares_blob(
+                 f.pts[static_cast<std::size_t>(j)].blob_index) &&
+             (X(i) - X(j)).squaredNorm() <= kMaxPairMm * kMaxPairMm;
+    };
+    int pair_count = 0;
+    for (int i = 0; i < n; ++i) {
+      std::vector<int> ref;
+      for (int j = 0; j < n; ++j)
+        if (pairs_with(i, j)) ref.push_back(j);
+      pair_count += static_cast<int>(ref.size());
+      std::vector<int> got(frame.neighbours(i), frame.neighbours(i) + frame.neighbour_count(i));
+      for (std::size_t e = 1; e < got.size(); ++e) {
+        const double before = (X(got[e - 1]) - X(i)).squaredNorm();
+        const double here = (X(got[e]) - X(i)).squaredNorm();
+        ASSERT_LE(before, here) << "point " << i << ", neighbour " << e;
+        ties += before == here;
+      }
+      std::sort(got.begin(), got.end());
+      ASSERT_EQ(got, ref) << "point " << i;
+      neighbours += static_cast<int>(got.size());
+    }
+    ASSERT_EQ(frame.pair_count() * 2, pair_count);
+    for (int q = 1; q < frame.pair_count(); ++q)
+      ASSERT_LE(frame.pairs()[q - 1].d_mm, frame.pairs()[q].d_mm);
+    for (int q = 0; q < frame.pair_count(); ++q) {
+      const PointPair& pp = frame.pairs()[q];
+      ASSERT_TRUE(pairs_with(pp.i, pp.j));
+      ASSERT_EQ(pp.d_mm, std::sqrt((X(pp.i) - X(pp.j)).squaredNorm()));
+    }
+  }
+  EXPECT_GT(neighbours, 2000);
+  EXPECT_GT(ties, 10) << "no equal distances: the order among them is not tested";
 }
 
 }  // namespace
