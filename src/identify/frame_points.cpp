@@ -1,7 +1,9 @@
 // Design: see frame_points.h. The pairs come from the grid (each point against the
-// points of its 27 neighbouring cells with a larger index, every bucket visited once) and
-// are sorted in place (std::sort allocates nothing); the neighbour lists are a CSR array
-// filled from the pairs, each list sorted by index (insertion sort: lists are short).
+// points of its 27 neighbouring cells with a larger index, every bucket visited once; the
+// points taken bucket by bucket, so the points of one cell share one collection of the
+// neighbouring buckets) and are sorted in place by distance, then index (std::sort
+// allocates nothing; the order does not depend on the grid's); the neighbour lists are a
+// CSR array filled from the sorted pairs, nearest first.
 // The partner lists come from the points' views chained per blob (last_view_ over the
 // frame's dense blob numbering): a view whose blob has earlier views shares it with their
 // points; a pair sharing blobs of several cameras is listed at its lowest shared camera
@@ -51,6 +53,7 @@ FramePoints::FramePoints(int max_points, int cameras)
       bucket_start_(bucket_count_for(max_points) + 1, 0),
       bucket_points_(static_cast<std::size_t>(max_points), 0),
       bucket_of_point_(static_cast<std::size_t>(max_points), 0),
+      cell_of_point_(static_cast<std::size_t>(max_points)),
       adj_start_(static_cast<std::size_t>(max_points) + 1, 0),
       adj_(pairs_.size() * 2, 0),
       cameras_(std::clamp(cameras, 1, kMaxCameras)),
@@ -82,7 +85,8 @@ void FramePoints::build_grid() noexcept {
   for (int i = 0; i < n_; ++i) {
     const auto s = static_cast<std::size_t>(i);
     if (!valid_[s]) continue;
-    bucket_of_point_[s] = bucket_of(cell_of(X_[s]));
+    cell_of_point_[s] = cell_of(X_[s]);
+    bucket_of_point_[s] = bucket_of(cell_of_point_[s]);
     ++bucket_start_[bucket_of_point_[s] + 1];
   }
   for (std::size_t b = 1; b < bucket_start_.size(); ++b) bucket_start_[b] += bucket_start_[b - 1];
@@ -102,32 +106,44 @@ void FramePoints::build_pairs(double max2) noexcept {
   int c = 0;
   std::fill(adj_start_.begin(), adj_start_.begin() + n_ + 1, 0);
   std::array<std::uint32_t, 27> buckets{};
-  for (int i = 0; i < n_; ++i) {
-    if (!valid_[static_cast<std::size_t>(i)]) continue;
-    auto lo = cell_of(X(i)), hi = lo;
-    for (std::size_t a = 0; a < 3; ++a) {
-      --lo[a];
-      ++hi[a];
-    }
-    const int nbk = collect_buckets(
-        lo, hi, [this](const auto& cell) { return bucket_of(cell); }, buckets);
-    for (int q = 0; q < nbk; ++q) {
-      const std::uint32_t b = buckets[static_cast<std::size_t>(q)];
-      for (int e = bucket_start_[b]; e < bucket_start_[b + 1]; ++e) {
-        const int j = bucket_points_[static_cast<std::size_t>(e)];
-        if (j <= i || exclusive(i, j)) continue;
-        const double d2 = (X(i) - X(j)).squaredNorm();
-        if (d2 > max2) continue;
-        pairs_[static_cast<std::size_t>(c++)] =
-            PointPair{std::sqrt(d2), static_cast<std::int16_t>(i), static_cast<std::int16_t>(j)};
-        ++adj_start_[static_cast<std::size_t>(i) + 1];
-        ++adj_start_[static_cast<std::size_t>(j) + 1];
+  int nbk = 0;
+  const std::array<std::int64_t, 3>* collected = nullptr;  // the cell `buckets` are around
+  // The valid points bucket by bucket (the grid holds only those): a bucket's points are
+  // usually one cell's, and share its neighbouring buckets.
+  for (std::size_t pb = 0; pb + 1 < bucket_start_.size(); ++pb) {
+    for (int pe = bucket_start_[pb]; pe < bucket_start_[pb + 1]; ++pe) {
+      const int i = bucket_points_[static_cast<std::size_t>(pe)];
+      const std::array<std::int64_t, 3>& cell = cell_of_point_[static_cast<std::size_t>(i)];
+      if (collected == nullptr || *collected != cell) {
+        auto lo = cell, hi = cell;
+        for (std::size_t a = 0; a < 3; ++a) {
+          --lo[a];
+          ++hi[a];
+        }
+        nbk = collect_buckets(
+            lo, hi, [this](const auto& x) { return bucket_of(x); }, buckets);
+        collected = &cell;
+      }
+      for (int q = 0; q < nbk; ++q) {
+        const std::uint32_t b = buckets[static_cast<std::size_t>(q)];
+        for (int e = bucket_start_[b]; e < bucket_start_[b + 1]; ++e) {
+          const int j = bucket_points_[static_cast<std::size_t>(e)];
+          if (j <= i) continue;
+          const double d2 = (X(i) - X(j)).squaredNorm();
+          if (d2 > max2 || exclusive(i, j)) continue;
+          pairs_[static_cast<std::size_t>(c++)] =
+              PointPair{std::sqrt(d2), static_cast<std::int16_t>(i), static_cast<std::int16_t>(j)};
+          ++adj_start_[static_cast<std::size_t>(i) + 1];
+          ++adj_start_[static_cast<std::size_t>(j) + 1];
+        }
       }
     }
   }
   pair_count_ = c;
-  std::sort(pairs_.begin(), pairs_.begin() + c,
-            [](const PointPair& a, const PointPair& b) { return a.d_mm < b.d_mm; });
+  // By distance, then by index: an order of the pairs alone, whatever the grid's.
+  std::sort(pairs_.begin(), pairs_.begin() + c, [](const PointPair& a, const PointPair& b) {
+    return a.d_mm != b.d_mm ? a.d_mm < b.d_mm : a.i != b.i ? a.i < b.i : a.j < b.j;
+  });
   for (int i = 0; i < n_; ++i)
     adj_start_[static_cast<std::size_t>(i) + 1] += adj_start_[static_cast<std::size_t>(i)];
   // Fill with a moving cursor per point (adj_start_[i + 1] temporarily) from the pairs in

@@ -1,12 +1,11 @@
 // Design: the per-frame view of the measured points shared by every target's search:
-// positions, the measured pair distances sorted ascending (only pairs short enough to
-// be any target's pair, and never two mutually exclusive points), each point's
-// neighbours (the points it forms such a pair with, nearest first: a search for the
-// points at a given distance from it bisects the list), a uniform grid of
-// the points for radius queries (the temporal path's gates), and an occupancy state
-// (points and per-camera blobs in use) that the depth-first search and the multi-body
-// conflict resolution acquire and release. A point is available only when neither it
-// nor any point sharing a blob with it is taken, which enforces "at most one of mutually
+// positions, the measured pair distances sorted ascending, ties by index (only pairs short enough
+// to be any target's pair, and never two mutually exclusive points), each point's neighbours (the
+// points it forms such a pair with, nearest first: a search for the points at a given distance from
+// it bisects the list), a uniform grid of the points for radius queries (the temporal path's
+// gates), and an occupancy state (points and per-camera blobs in use) that the depth-first search
+// and the multi-body conflict resolution acquire and release. A point is available only when
+// neither it nor any point sharing a blob with it is taken, which enforces "at most one of mutually
 // exclusive candidates" and "a point belongs to at most one body" in one test. The
 // points sharing a blob (each point's partners) are listed once per frame at load() (the
 // frame's blobs numbered densely per camera, each view chained to the blob's previous
@@ -121,6 +120,7 @@ class FramePoints {
   std::vector<std::int32_t> bucket_start_;  // counting sort of the points by bucket
   std::vector<std::int16_t> bucket_points_;
   std::vector<std::uint32_t> bucket_of_point_;
+  std::vector<std::array<std::int64_t, 3>> cell_of_point_;
   std::vector<std::int32_t> adj_start_;  // CSR neighbour lists
   std::vector<std::int16_t> adj_;
   int cameras_;

@@ -5,7 +5,7 @@
 // it, each sharing point is a partner once (however many blobs the two share), and
 // release_all() and the next load() start from nothing. The pairs and each point's
 // neighbours against their definition: every two valid points no farther apart than the
-// bound and sharing no blob, the pairs in ascending distance, each point's neighbours
+// bound and sharing no blob, the pairs by distance then index, each point's neighbours
 // nearest first by the squared distance a search compares.
 #include <gtest/gtest.h>
 
@@ -13,6 +13,7 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <tuple>
 #include <vector>
 
 #include "identify/frame_points.h"
@@ -98,7 +99,7 @@ TEST(FramePoints, ThePairsAndEachPointsNeighboursNearestFirstFollowTheirDefiniti
   constexpr int kCameras = 4;
   constexpr double kMaxPairMm = 300.0;
   FramePoints frame(120, kCameras);
-  int neighbours = 0, ties = 0;
+  int neighbours = 0, ties = 0, pair_ties = 0;
   for (int trial = 0; trial < 40; ++trial) {
     const int n = 20 + 2 * trial;
     RandomFrame f = random_frame(rng, n, kCameras, 20 + trial);
@@ -132,17 +133,25 @@ TEST(FramePoints, ThePairsAndEachPointsNeighboursNearestFirstFollowTheirDefiniti
       ASSERT_EQ(got, ref) << "point " << i;
       neighbours += static_cast<int>(got.size());
     }
+    // The pairs: i < j, by distance, then by index (whatever the grid's order).
+    std::vector<std::tuple<double, int, int>> ref_pairs;
+    for (int i = 0; i < n; ++i)
+      for (int j = i + 1; j < n; ++j)
+        if (pairs_with(i, j)) ref_pairs.emplace_back(std::sqrt((X(i) - X(j)).squaredNorm()), i, j);
+    std::sort(ref_pairs.begin(), ref_pairs.end());
     ASSERT_EQ(frame.pair_count() * 2, pair_count);
-    for (int q = 1; q < frame.pair_count(); ++q)
-      ASSERT_LE(frame.pairs()[q - 1].d_mm, frame.pairs()[q].d_mm);
+    ASSERT_EQ(static_cast<std::size_t>(frame.pair_count()), ref_pairs.size());
     for (int q = 0; q < frame.pair_count(); ++q) {
       const PointPair& pp = frame.pairs()[q];
-      ASSERT_TRUE(pairs_with(pp.i, pp.j));
-      ASSERT_EQ(pp.d_mm, std::sqrt((X(pp.i) - X(pp.j)).squaredNorm()));
+      ASSERT_EQ(std::make_tuple(pp.d_mm, static_cast<int>(pp.i), static_cast<int>(pp.j)),
+                ref_pairs[static_cast<std::size_t>(q)])
+          << "pair " << q;
+      pair_ties += q > 0 && frame.pairs()[q - 1].d_mm == pp.d_mm;
     }
   }
   EXPECT_GT(neighbours, 2000);
   EXPECT_GT(ties, 10) << "no equal distances: the order among them is not tested";
+  EXPECT_GT(pair_ties, 10) << "no pairs of equal distance: their order is not tested";
 }
 
 }  // namespace
